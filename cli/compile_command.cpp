@@ -1,0 +1,139 @@
+#include "cli/compile_command.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <filesystem>
+#include <map>
+#include <fmt/format.h>
+#include <iostream>
+
+#include "cli/exit_codes.hpp"
+#include "cli/read_file.hpp"
+#include "compiler/compiled_model.hpp"
+#include "compiler/pipeline.hpp"
+#include "compiler/print.hpp"
+#include "grammar/ast_printer.hpp"
+#include "grammar/diagnostic_catalogue.hpp"
+
+namespace sidc {
+namespace {
+
+struct CompileArguments {
+  std::string model;
+  std::string output;
+  std::string integrate;
+  std::string dump;
+  std::string dump_after;
+};
+
+std::vector<std::string> pass_names() {
+  std::vector<std::string> names;
+  for (const auto& p : passes()) names.emplace_back(p.name);
+  return names;
+}
+
+// Which pass a --dump or --dump-after value names; nullopt after printing the diagnostic.
+std::optional<std::string> pass_to_stop_after(const CompileArguments& a) {
+  static const std::map<std::string, std::string> stages{{"ast", "parse"}, {"normalized", "normalize"}, {"integrated", "integrate"}};
+  if (!a.dump.empty()) {
+    if (auto it = stages.find(a.dump); it != stages.end()) return it->second;
+    std::cerr << render(diag::unknown_pass(a.dump, diag::nearest(a.dump, {"ast", "normalized", "integrated"}), "ast, normalized, integrated")) << "\n";
+    return std::nullopt;
+  }
+  const auto names = pass_names();
+  if (std::find(names.begin(), names.end(), a.dump_after) != names.end()) return a.dump_after;
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  std::cerr << render(diag::unknown_pass(a.dump_after, diag::nearest(a.dump_after, names), list)) << "\n";
+  return std::nullopt;
+}
+
+// A comment block heading the printed model: where it came from, and what integration added.
+std::string summary(const ir::Model& m, const std::string& path) {
+  std::string out = fmt::format("# {}: {} equation{}, {} parameter{}\n", path, m.equations.size(), m.equations.size() == 1 ? "" : "s",
+                                m.parameters.size(), m.parameters.size() == 1 ? "" : "s");
+  std::string implicit, constants;
+  for (const auto& p : m.parameters) {
+    if (p.origin == ir::Parameter::Origin::implicit) implicit += (implicit.empty() ? "" : ", ") + p.name;
+    if (p.origin == ir::Parameter::Origin::integration_constant)
+      constants += fmt::format("{}{} (equation {})", constants.empty() ? "" : ", ", p.name, p.equation + 1);
+  }
+  if (!implicit.empty()) out += "# no `param` declaration: parameters taken from the free names: " + implicit + "\n";
+  for (std::size_t i = 0; i < m.equations.size(); ++i) {
+    const int n = m.equations[i].integrations;
+    if (n > 0) out += fmt::format("# equation {} integrated {} time{} from t0 to t\n", i + 1, n, n == 1 ? "" : "s");
+  }
+  if (!constants.empty()) out += "# integration constants: " + constants + "\n";
+  return out;
+}
+
+int run_compile(const CompileArguments& a) {
+  std::string error;
+  auto text = read_whole_file(a.model, error);
+  if (!text) {
+    std::cerr << error << "\nhint: give the path of a model file, e.g. `sidc compile examples/thesis-4-1/quasi_linear.sid`\n";
+    return exit_code::user_error;
+  }
+  CompileOptions options;
+  if (!a.integrate.empty()) {
+    ir::IntegrationRequest r;
+    if (a.integrate == "auto") {
+      r.count = ir::IntegrationRequest::Count::automatic;
+    } else {
+      int n = -1;
+      const auto [end, ec] = std::from_chars(a.integrate.data(), a.integrate.data() + a.integrate.size(), n);
+      if (ec != std::errc() || end != a.integrate.data() + a.integrate.size() || n < 0 || n > 8) {
+        std::cerr << render(diag::integrate_option_invalid(a.integrate)) << "\n";
+        return exit_code::usage_error;
+      }
+      r.times = n;
+    }
+    options.integrate.override_request = r;
+  }
+  const bool dumping = !a.dump.empty() || !a.dump_after.empty();
+  if (dumping) {
+    auto stop = pass_to_stop_after(a);
+    if (!stop) return exit_code::usage_error;
+    options.stop_after = *stop;
+  }
+  auto source = std::make_shared<const SourceFile>(a.model, std::move(*text));
+  CompileResult r = compile(source, options);
+  std::cerr << r.diagnostics.render_all();
+  if (!r.ok()) return exit_code::user_error;
+
+  if (dumping) {
+    if (r.last_pass == "parse") std::cout << print_ast(r.parsed.model);
+    else if (r.last_pass == "declare") std::cout << "# declarations checked; nothing is rewritten before `lower`\n";
+    else if (r.last_pass == "lower") std::cout << r.lowered_text;
+    else if (r.last_pass == "normalize") std::cout << print(*r.normalized);
+    else std::cout << print(*r.integrated);
+    return exit_code::success;
+  }
+
+  std::cout << summary(*r.integrated, a.model) << print(*r.integrated);
+  std::string output = a.output;
+  if (output.empty()) output = std::filesystem::path(a.model).replace_extension(".sidc.json").string();
+  const std::string json = to_json(CompiledModel{source, *r.normalized, *r.integrated}).dump(1) + "\n";
+  if (!write_file_atomically(output, json, error)) {
+    std::cerr << error << "\nhint: choose a writable place with `-o FILE`\n";
+    return exit_code::user_error;
+  }
+  std::cerr << "wrote " << output << "\n";
+  return exit_code::success;
+}
+
+}  // namespace
+
+void add_compile_command(CLI::App& app, int& exit_status) {
+  auto args = std::make_shared<CompileArguments>();
+  CLI::App* cmd = app.add_subcommand("compile", "Check a model file, rewrite it into integrated form, and write the compiled model");
+  cmd->add_option("model", args->model, "The model file (.sid)")->required();
+  cmd->add_option("-o,--output", args->output, "Where to write the compiled model (default: MODEL with extension .sidc.json)");
+  cmd->add_option("--integrate", args->integrate, "Integrate every equation N times (0-8), or `auto`; overrides the file");
+  auto* dump = cmd->add_option("--dump", args->dump, "Print one stage instead of compiling: ast, normalized or integrated");
+  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, integrate)")
+      ->excludes(dump);
+  cmd->callback([args, &exit_status] { exit_status = run_compile(*args); });
+}
+
+}  // namespace sidc

@@ -1,0 +1,295 @@
+#include "compiler/compiled_model.hpp"
+
+#include <fmt/format.h>
+
+#include "compiler/print.hpp"
+#include "compiler/settings.hpp"
+
+namespace sidc {
+namespace {
+
+using nlohmann::json;
+using ordered = nlohmann::ordered_json;
+using ir::FactorKind;
+
+const char* kind_name(FactorKind k) {
+  switch (k) {
+    case FactorKind::parameter: return "parameter";
+    case FactorKind::signal: return "signal";
+    case FactorKind::time: return "time";
+    case FactorKind::elapsed: return "elapsed";
+    case FactorKind::window_start: return "window_start";
+    case FactorKind::initial_value: return "initial_value";
+    case FactorKind::function: return "function";
+    case FactorKind::power: return "power";
+    case FactorKind::derivative: return "derivative";
+    case FactorKind::integral: return "integral";
+    case FactorKind::guard: return "guard";
+  }
+  return "?";
+}
+
+std::optional<FactorKind> kind_from(const std::string& s) {
+  for (int k = 0; k <= static_cast<int>(FactorKind::guard); ++k)
+    if (s == kind_name(static_cast<FactorKind>(k))) return static_cast<FactorKind>(k);
+  return std::nullopt;
+}
+
+const char* relation_name(ir::Relation r) {
+  switch (r) {
+    case ir::Relation::less: return "<";
+    case ir::Relation::less_equal: return "<=";
+    case ir::Relation::greater: return ">";
+    case ir::Relation::greater_equal: return ">=";
+  }
+  return "<";
+}
+
+ordered number_json(const Number& n) {
+  if (n.exact()) return ordered{{"num", n.numerator()}, {"den", n.denominator()}};
+  return ordered{{"real", n.value()}};
+}
+
+ordered span_json(const Span& s) {
+  if (!s.known()) return nullptr;
+  const auto p = s.start();
+  return ordered{{"line", p.line}, {"column", p.column}, {"length", s.length()}, {"offset", s.begin}};
+}
+
+ordered sum_json(const ir::Sum& s);
+
+ordered factor_json(const ir::Factor& f, int power) {
+  ordered j{{"kind", kind_name(f.kind)}};
+  switch (f.kind) {
+    case FactorKind::parameter: j["name"] = f.name; break;
+    case FactorKind::signal: j["name"] = f.name, j["order"] = f.order; break;
+    case FactorKind::initial_value:
+      j["name"] = f.name, j["order"] = f.order;
+      j["at"] = f.at ? number_json(*f.at) : ordered(nullptr);
+      break;
+    case FactorKind::function: j["name"] = f.name, j["argument"] = sum_json(*f.argument); break;
+    case FactorKind::power: j["exponent"] = number_json(f.exponent), j["argument"] = sum_json(*f.argument); break;
+    case FactorKind::derivative: j["order"] = f.order, j["argument"] = sum_json(*f.argument); break;
+    case FactorKind::integral: j["argument"] = sum_json(*f.argument); break;
+    case FactorKind::guard: {
+      ordered conditions = ordered::array();
+      for (const auto& c : f.conditions)
+        conditions.push_back(ordered{{"lhs", sum_json(*c.lhs)}, {"relation", relation_name(c.relation)}, {"rhs", sum_json(*c.rhs)}});
+      j["conditions"] = std::move(conditions);
+      break;
+    }
+    default: break;
+  }
+  j["power"] = power;
+  return j;
+}
+
+ordered sum_json(const ir::Sum& s) {
+  ordered terms = ordered::array();
+  for (const auto& t : s.terms) {
+    ordered factors = ordered::array();
+    for (const auto& [f, power] : t.factors) factors.push_back(factor_json(f, power));
+    terms.push_back(ordered{{"coefficient", number_json(t.coefficient)}, {"factors", std::move(factors)}, {"span", span_json(t.span)}});
+  }
+  return ordered{{"text", print(s)}, {"terms", std::move(terms)}};
+}
+
+ordered optional_number(const std::optional<double>& v) { return v ? ordered(*v) : ordered(nullptr); }
+
+ordered settings_json(const ir::Settings& raw) {
+  const EvaluationSettings e = evaluation_settings(raw);
+  ordered j;
+  j["derivative"] = {{"method", "savitzky_golay"}, {"window", e.derivative.window}, {"order", e.derivative.order}};
+  j["second_derivative"] = e.second_derivative_repeated ? "repeated" : "direct";
+  j["edges"] = e.shorten_edges ? "shorten" : "drop";
+  j["integration"] = e.trapezoid ? "trapezoid" : "simpson";
+  j["smooth_before_integration"] =
+      e.smooth_before_integration ? ordered{{"window", e.smooth_before_integration->window}, {"order", e.smooth_before_integration->order}}
+                                  : ordered(nullptr);
+  j["from"] = optional_number(e.from);
+  j["to"] = optional_number(e.to);
+  j["every"] = e.every;
+  j["step"] = optional_number(e.step);
+  ordered as_written = ordered::object();
+  for (const auto& [key, value] : raw.values) as_written[key] = value.text;
+  j["as_written"] = std::move(as_written);
+  return j;
+}
+
+const char* origin_name(ir::Parameter::Origin o) {
+  switch (o) {
+    case ir::Parameter::Origin::declared: return "declared";
+    case ir::Parameter::Origin::implicit: return "implicit";
+    case ir::Parameter::Origin::integration_constant: return "integration_constant";
+  }
+  return "declared";
+}
+
+// ---- reading ------------------------------------------------------------------------------------
+
+struct Reader {
+  std::shared_ptr<const SourceFile> source;
+
+  Span span(const json& j) const {
+    if (j.is_null()) return {};
+    const std::size_t begin = j.at("offset").get<std::size_t>();
+    return Span{source, begin, begin + j.at("length").get<std::size_t>()};
+  }
+  Number number(const json& j) const {
+    if (j.contains("real")) return Number::real(j.at("real").get<double>());
+    const auto den = j.at("den").get<std::int64_t>();
+    if (den <= 0) throw std::runtime_error("a denominator is not positive");
+    return Number::rational(j.at("num").get<std::int64_t>(), den);
+  }
+  ir::SumPtr sum_ptr(const json& j) const { return ir::share(sum(j)); }
+  ir::Sum sum(const json& j) const {
+    std::vector<ir::Term> terms;
+    for (const auto& t : j.at("terms")) {
+      ir::Term term{number(t.at("coefficient")), {}, span(t.at("span"))};
+      for (const auto& f : t.at("factors")) term.factors.push_back({factor(f), f.at("power").get<int>()});
+      terms.push_back(ir::canonical(std::move(term)));
+    }
+    return ir::canonical(std::move(terms));
+  }
+  ir::Factor factor(const json& j) const {
+    const auto kind = kind_from(j.at("kind").get<std::string>());
+    if (!kind) throw std::runtime_error("unknown factor kind `" + j.at("kind").get<std::string>() + "`");
+    ir::Factor f{*kind, j.value("name", std::string()), j.value("order", 0), {}, {}, {}, {}};
+    if (*kind == FactorKind::initial_value && !j.at("at").is_null()) f.at = number(j.at("at"));
+    if (j.contains("exponent")) f.exponent = number(j.at("exponent"));
+    if (j.contains("argument")) f.argument = sum_ptr(j.at("argument"));
+    if (*kind == FactorKind::guard)
+      for (const auto& c : j.at("conditions")) {
+        const std::string r = c.at("relation").get<std::string>();
+        const ir::Relation rel = r == "<" ? ir::Relation::less : r == "<=" ? ir::Relation::less_equal
+                               : r == ">" ? ir::Relation::greater : ir::Relation::greater_equal;
+        f.conditions.push_back({sum_ptr(c.at("lhs")), rel, sum_ptr(c.at("rhs"))});
+      }
+    return f;
+  }
+};
+
+ordered model_json(const ir::Model& m, bool with_trees) {
+  ordered equations = ordered::array();
+  for (std::size_t i = 0; i < m.equations.size(); ++i) {
+    const auto& e = m.equations[i];
+    ordered operations = ordered::array();
+    for (const auto& [index, op] : e.terms) {
+      ordered o{{"parameter", m.parameters[static_cast<std::size_t>(index)].name}};
+      if (with_trees) o["operation"] = sum_json(op);
+      else o["operation"] = print(op);
+      operations.push_back(std::move(o));
+    }
+    ordered eq{{"text", print(e, m)}, {"span", span_json(e.span)}, {"integrations", e.integrations},
+               {"constants", e.integration.constants == ir::IntegrationRequest::Constants::initial ? "initial" : "fitted"},
+               {"operations", std::move(operations)}};
+    eq["known"] = with_trees ? sum_json(e.known) : ordered(print(e.known));
+    equations.push_back(std::move(eq));
+  }
+  return equations;
+}
+
+}  // namespace
+
+std::string source_hash(const std::string& text) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return fmt::format("fnv1a64:{:016x}", h);
+}
+
+nlohmann::ordered_json to_json(const CompiledModel& c) {
+  const ir::Model& m = c.integrated;
+  ordered j;
+  j["format"] = "sidc-compiled-model";
+  j["version"] = kCompiledModelVersion;
+  j["sidc_version"] = SIDC_VERSION;
+  j["source"] = {{"path", c.source->name}, {"hash", source_hash(c.source->text)}, {"text", c.source->text}};
+  j["model"] = m.name;
+  ordered signals = ordered::array();
+  for (const auto& s : m.signals)
+    signals.push_back(ordered{{"name", s.name}, {"kind", s.kind == ir::Signal::Kind::input ? "input" : "output"},
+                              {"definition", s.definition ? sum_json(*s.definition) : ordered(nullptr)}, {"span", span_json(s.span)}});
+  j["signals"] = std::move(signals);
+  ordered parameters = ordered::array();
+  for (const auto& p : m.parameters)
+    parameters.push_back(ordered{{"name", p.name}, {"origin", origin_name(p.origin)}, {"equation", p.equation}, {"span", span_json(p.span)}});
+  j["parameters"] = std::move(parameters);
+  ordered constants = ordered::object();
+  for (const auto& [name, value] : m.constants) constants[name] = number_json(value);
+  j["constants"] = std::move(constants);
+  j["settings"] = settings_json(m.settings);
+  ordered data = ordered::array();
+  for (const auto& d : m.data) {
+    ordered bindings = ordered::object();
+    for (const auto& [signal, column] : d.bindings) bindings[signal] = column;
+    data.push_back(ordered{{"path", d.path}, {"bindings", std::move(bindings)}});
+  }
+  j["data"] = std::move(data);
+  j["normalized"] = model_json(c.normalized, false);
+  j["equations"] = model_json(m, true);
+  return j;
+}
+
+std::optional<CompiledModel> compiled_model_from_json(const nlohmann::json& j, const std::string& path, std::string& error) {
+  try {
+    if (j.value("format", std::string()) != "sidc-compiled-model") {
+      error = fmt::format("error: `{}` is not a compiled sidc model", path);
+      return std::nullopt;
+    }
+    if (j.at("version").get<int>() != kCompiledModelVersion) {
+      error = fmt::format("error: `{}` was written in compiled-model format {}, this sidc reads format {}", path,
+                          j.at("version").get<int>(), kCompiledModelVersion);
+      return std::nullopt;
+    }
+    CompiledModel c;
+    c.source = std::make_shared<const SourceFile>(j.at("source").at("path").get<std::string>(), j.at("source").at("text").get<std::string>());
+    Reader r{c.source};
+    ir::Model& m = c.integrated;
+    m.name = j.at("model").get<std::string>();
+    for (const auto& s : j.at("signals")) {
+      ir::Signal sig;
+      sig.name = s.at("name").get<std::string>();
+      sig.kind = s.at("kind").get<std::string>() == "input" ? ir::Signal::Kind::input : ir::Signal::Kind::output;
+      sig.span = r.span(s.at("span"));
+      sig.used = true;
+      if (!s.at("definition").is_null()) sig.definition = r.sum(s.at("definition"));
+      m.signals.push_back(std::move(sig));
+    }
+    for (const auto& p : j.at("parameters")) {
+      const std::string origin = p.at("origin").get<std::string>();
+      m.parameters.push_back({p.at("name").get<std::string>(),
+                              origin == "implicit" ? ir::Parameter::Origin::implicit
+                              : origin == "integration_constant" ? ir::Parameter::Origin::integration_constant
+                                                                  : ir::Parameter::Origin::declared,
+                              r.span(p.at("span")), p.at("equation").get<int>()});
+    }
+    for (const auto& [name, value] : j.at("constants").items()) m.constants.emplace(name, r.number(value));
+    for (const auto& [key, value] : j.at("settings").at("as_written").items()) m.settings.values[key] = {value.get<std::string>(), {}};
+    for (const auto& d : j.at("data")) {
+      ir::DataSource source;
+      source.path = d.at("path").get<std::string>();
+      for (const auto& [signal, column] : d.at("bindings").items()) source.bindings.emplace_back(signal, column.get<std::string>());
+      m.data.push_back(std::move(source));
+    }
+    for (const auto& e : j.at("equations")) {
+      ir::Equation eq;
+      eq.span = r.span(e.at("span"));
+      eq.integrations = e.at("integrations").get<int>();
+      eq.integration.constants = e.at("constants").get<std::string>() == "initial" ? ir::IntegrationRequest::Constants::initial
+                                                                                   : ir::IntegrationRequest::Constants::fitted;
+      for (const auto& o : e.at("operations")) {
+        const int index = m.parameter_index(o.at("parameter").get<std::string>());
+        if (index < 0) throw std::runtime_error("an operation names an undeclared parameter");
+        eq.terms.push_back({index, r.sum(o.at("operation"))});
+      }
+      eq.known = r.sum(e.at("known"));
+      m.equations.push_back(std::move(eq));
+    }
+    return c;
+  } catch (const std::exception& ex) {
+    error = fmt::format("error: `{}` is not a valid compiled model ({}); compile the model again with `sidc compile`", path, ex.what());
+    return std::nullopt;
+  }
+}
+
+}  // namespace sidc

@@ -1,0 +1,189 @@
+#include "compiler/declare_pass.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+#include "compiler/settings.hpp"
+#include "grammar/diagnostic_catalogue.hpp"
+
+namespace sidc {
+
+const std::vector<std::string>& function_names() {
+  static const std::vector<std::string> names{"sin", "cos", "exp", "log", "sqrt", "abs", "sign", "tanh", "der", "int"};
+  return names;
+}
+
+bool is_function_name(const std::string& name) {
+  const auto& f = function_names();
+  return std::find(f.begin(), f.end(), name) != f.end();
+}
+
+bool is_builtin_name(const std::string& name) {
+  return name == "t" || name == "t0" || name == "tau" || name == "pi" || name == "sum" || is_function_name(name);
+}
+
+namespace {
+
+struct Declarer {
+  const ParseResult& parsed;
+  Diagnostics& diagnostics;
+  Declarations out;
+  ir::IntegrationRequest current_integration;
+  std::map<std::string, Span> set_once;  // global settings already seen
+
+  Span span(const boost::spirit::x3::position_tagged& node) const { return parsed.span(node); }
+
+  // Records a new name; false (and a diagnostic) when it is built-in or taken.
+  bool declare(const std::string& name, const Span& where) {
+    if (is_builtin_name(name)) {
+      diagnostics.add(diag::reserved_name(where, name));
+      return false;
+    }
+    if (auto it = out.names.find(name); it != out.names.end()) {
+      diagnostics.add(diag::declared_twice(where, name, it->second));
+      return false;
+    }
+    out.names.emplace(name, where);
+    return true;
+  }
+
+  void operator()(const ast::ModelName& m) {
+    if (!out.model.name.empty()) diagnostics.add(diag::setting_repeated(span(m), "model", out.model.name_span));
+    out.model.name = m.name.name;
+    out.model.name_span = span(m);
+  }
+
+  void operator()(const ast::SignalDeclaration& d) {
+    for (const auto& item : d.signals) {
+      const Span where = span(item.name);
+      if (!declare(item.name.name, where)) continue;
+      ir::Signal s;
+      s.name = item.name.name;
+      s.kind = d.kind == "input" ? ir::Signal::Kind::input : ir::Signal::Kind::output;
+      s.span = where;
+      if (item.definition) {
+        if (s.kind == ir::Signal::Kind::output) {
+          diagnostics.add(diag::bad_setting_value(where, "output", s.name + " = ...", "only names; an input may be given as an expression of t"));
+          continue;
+        }
+        out.input_definitions.push_back({out.model.signals.size(), &*item.definition});
+      }
+      out.model.signals.push_back(std::move(s));
+    }
+  }
+
+  void operator()(const ast::ParameterDeclaration& d) {
+    out.parameters_declared = true;
+    for (const auto& item : d.parameters) {
+      const Span where = span(item);
+      if (!declare(item.name.name, where)) continue;
+      if (item.from && item.to) {
+        const int from = *item.from, to = *item.to;
+        if (from > to) {
+          diagnostics.add(diag::bad_range(where, from, to));
+          continue;
+        }
+        if (static_cast<long long>(to) - from + 1 > kMaxFamilySize) {
+          diagnostics.add(diag::range_too_large(where, static_cast<long long>(to) - from + 1, kMaxFamilySize));
+          continue;
+        }
+        out.families[item.name.name] = {from, to};
+        for (int k = from; k <= to; ++k)
+          out.model.parameters.push_back({fmt::format("{}[{}]", item.name.name, k), ir::Parameter::Origin::declared, where, -1});
+      } else {
+        out.model.parameters.push_back({item.name.name, ir::Parameter::Origin::declared, where, -1});
+      }
+    }
+  }
+
+  void operator()(const ast::ConstantDeclaration& d) {
+    for (const auto& item : d.constants) {
+      const Span where = span(item.name);
+      if (declare(item.name.name, where)) out.constants.push_back({item.name.name, &item.value, where});
+    }
+  }
+
+  void operator()(const ast::DataStatement& d) {
+    ir::DataSource source;
+    source.path = d.path;
+    source.span = span(d);
+    for (const auto& b : d.bindings) {
+      const Span where = span(b);
+      const auto already = std::find_if(source.bindings.begin(), source.bindings.end(),
+                                        [&](const auto& x) { return x.first == b.signal.name; });
+      if (already != source.bindings.end()) {
+        diagnostics.add(diag::binding_repeated(where, b.signal.name));
+        continue;
+      }
+      source.bindings.emplace_back(b.signal.name, b.column);
+      source.binding_spans.push_back(where);
+    }
+    out.model.data.push_back(std::move(source));
+  }
+
+  void operator()(const ast::Setting& s) {
+    const std::string& key = s.key.name;
+    const Span key_span = span(s.key);
+    const Span value_span{parsed.source, s.value_offset, s.value_offset + s.value.size()};
+    const auto problem = check_setting(key, s.value);
+    if (problem.unknown_key) {
+      diagnostics.add(diag::unknown_setting(key_span, key, diag::nearest(key, setting_keys())));
+      return;
+    }
+    if (!problem.expected.empty()) {
+      diagnostics.add(diag::bad_setting_value(value_span, key, s.value, problem.expected));
+      return;
+    }
+    if (key == "integrate") {
+      current_integration.span = value_span;
+      if (s.value == "auto") {
+        current_integration.count = ir::IntegrationRequest::Count::automatic;
+      } else {
+        current_integration.count = ir::IntegrationRequest::Count::fixed;
+        current_integration.times = std::stoi(s.value);
+      }
+      return;
+    }
+    if (key == "constants") {
+      current_integration.constants =
+          s.value == "initial" ? ir::IntegrationRequest::Constants::initial : ir::IntegrationRequest::Constants::fitted;
+      return;
+    }
+    if (auto it = set_once.find(key); it != set_once.end()) {
+      diagnostics.add(diag::setting_repeated(key_span, key, it->second));
+      return;
+    }
+    set_once.emplace(key, key_span);
+    out.model.settings.values[key] = {s.value, value_span};
+  }
+
+  void operator()(const ast::Equation& e) { out.equations.push_back({&e, current_integration}); }
+};
+
+}  // namespace
+
+Declarations declare_pass(const ParseResult& parsed, Diagnostics& diagnostics) {
+  Declarer d{parsed, diagnostics, {}, {}, {}};
+  for (const auto& statement : parsed.model.statements) boost::apply_visitor(d, statement);
+
+  // Bindings name declared signals (or `t`), and not inputs given as expressions.
+  for (auto& source : d.out.model.data) {
+    for (std::size_t i = 0; i < source.bindings.size(); ++i) {
+      const auto& name = source.bindings[i].first;
+      const Span& where = source.binding_spans[i];
+      if (name == "t") continue;
+      const ir::Signal* s = d.out.model.signal(name);
+      if (!s) {
+        std::vector<std::string> candidates{"t"};
+        for (const auto& x : d.out.model.signals) candidates.push_back(x.name);
+        diagnostics.add(diag::binding_unknown_signal(where, name, diag::nearest(name, candidates)));
+      } else if (std::any_of(d.out.input_definitions.begin(), d.out.input_definitions.end(),
+                             [&](const auto& def) { return d.out.model.signals[def.signal].name == name; })) {
+        diagnostics.add(diag::binding_of_defined_input(where, name));
+      }
+    }
+  }
+  return std::move(d.out);
+}
+
+}  // namespace sidc

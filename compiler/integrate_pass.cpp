@@ -1,0 +1,268 @@
+#include "compiler/integrate_pass.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+#include "compiler/differentiate.hpp"
+#include "compiler/lower_pass.hpp"
+#include "compiler/settings.hpp"
+#include "grammar/diagnostic_catalogue.hpp"
+
+namespace sidc {
+namespace {
+
+using ir::Factor;
+using ir::FactorKind;
+using ir::Sum;
+using ir::Term;
+
+Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
+
+int burden(const Sum& s);
+int burden(const Factor& f) {
+  switch (f.kind) {
+    case FactorKind::signal:
+    case FactorKind::initial_value: return f.order;
+    case FactorKind::derivative: return f.order + burden(*f.argument);
+    case FactorKind::function:
+    case FactorKind::power:
+    case FactorKind::integral: return burden(*f.argument);
+    case FactorKind::guard: {
+      int b = 0;
+      for (const auto& c : f.conditions) b = std::max({b, burden(*c.lhs), burden(*c.rhs)});
+      return b;
+    }
+    default: return 0;
+  }
+}
+int burden(const Sum& s) {
+  int b = 0;
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) b = std::max(b, burden(f));
+  return b;
+}
+
+// Anything that changes with time: a static equation (a plain regression) has none of these.
+bool is_dynamic(const Sum& s);
+bool is_dynamic(const Factor& f) {
+  switch (f.kind) {
+    case FactorKind::signal: return f.order > 0;
+    case FactorKind::time:
+    case FactorKind::elapsed:
+    case FactorKind::derivative:
+    case FactorKind::integral: return true;
+    case FactorKind::function:
+    case FactorKind::power: return is_dynamic(*f.argument);
+    case FactorKind::guard:
+      return std::any_of(f.conditions.begin(), f.conditions.end(),
+                         [](const ir::Condition& c) { return is_dynamic(*c.lhs) || is_dynamic(*c.rhs); });
+    default: return false;
+  }
+}
+bool is_dynamic(const Sum& s) {
+  return std::any_of(s.terms.begin(), s.terms.end(), [](const Term& t) {
+    return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return is_dynamic(f.first); });
+  });
+}
+
+bool has_guard(const Term& t) {
+  return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return f.first.kind == FactorKind::guard; });
+}
+
+// F(t0): the antiderivative's value at the start of the fit window, from the record (eq. 4-2.4).
+Sum at_window_start(const Sum& s);
+std::optional<Sum> factor_at_window_start(const Factor& f) {
+  switch (f.kind) {
+    case FactorKind::signal: {
+      Factor v = make(FactorKind::initial_value, f.name, f.order);  // at = nullopt: t0
+      return ir::factor(v);
+    }
+    case FactorKind::time: return ir::factor(make(FactorKind::window_start));
+    case FactorKind::elapsed:
+    case FactorKind::integral: return Sum{};  // both vanish at t0
+    case FactorKind::function: {
+      Factor g = f;
+      g.argument = ir::share(at_window_start(*f.argument));
+      return ir::factor(g);
+    }
+    case FactorKind::power: {
+      Factor g = f;
+      g.argument = ir::share(at_window_start(*f.argument));
+      return ir::factor(g);
+    }
+    case FactorKind::parameter:
+    case FactorKind::window_start:
+    case FactorKind::initial_value: return ir::factor(f);
+    default: return std::nullopt;  // never in an exact antiderivative
+  }
+}
+Sum at_window_start(const Sum& s) {
+  std::vector<Term> terms;
+  for (const auto& t : s.terms) {
+    Sum product = ir::number(t.coefficient, t.span);
+    for (const auto& [f, power] : t.factors) {
+      auto value = factor_at_window_start(f);
+      Sum p = value ? *value : Sum{};
+      Sum raised = ir::number(1);
+      if (power > 0) for (int k = 0; k < power; ++k) raised = ir::multiply(raised, p);
+      else raised = power == 0 ? ir::number(1) : (p.empty() ? Sum{} : *raise(p, Number(power)));
+      product = ir::multiply(product, raised);
+    }
+    terms.insert(terms.end(), product.terms.begin(), product.terms.end());
+  }
+  return ir::canonical(std::move(terms));
+}
+
+// Takes `t` off `remaining` (matched by factors and coefficient).
+bool take(std::vector<Term>& remaining, const Term& t) {
+  auto it = std::find_if(remaining.begin(), remaining.end(),
+                         [&](const Term& r) { return ir::compare_factors(r, t) == 0 && r.coefficient == t.coefficient; });
+  if (it == remaining.end()) return false;
+  remaining.erase(it);
+  return true;
+}
+
+// An exact antiderivative of `t` whose derivative consists of terms all present in `remaining`
+// (t among them); those terms are removed. Candidates lower one derivative of a signal by one
+// order: for y^2*y' the candidate y^3 has derivative 3*y^2*y', so y^3/3; for x'*y the candidate
+// x*y has derivative x'*y + x*y', accepted only if x*y' is there too.
+std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remaining) {
+  if (has_guard(t)) return std::nullopt;  // its antiderivative changes branch
+  auto [constant, rest] = split_constant_part(t);
+  // Powers of time alone: t^a -> t^(a+1)/(a+1), tau^b -> tau^(b+1)/(b+1), 1 -> tau.
+  if (rest.factors.empty() || (rest.factors.size() == 1 && (rest.factors[0].first.kind == FactorKind::time ||
+                                                            rest.factors[0].first.kind == FactorKind::elapsed) &&
+                               rest.factors[0].second >= 0)) {
+    const FactorKind kind = rest.factors.empty() ? FactorKind::elapsed : rest.factors[0].first.kind;
+    const int power = rest.factors.empty() ? 0 : rest.factors[0].second;
+    Term p{constant.coefficient / Number(power + 1), constant.factors, t.span};
+    p.factors.push_back({make(kind), power + 1});
+    take(remaining, t);
+    return ir::canonical(std::vector<Term>{ir::canonical(p)});
+  }
+  for (std::size_t i = 0; i < t.factors.size(); ++i) {
+    const auto& [f, power] = t.factors[i];
+    if (f.kind != FactorKind::signal || f.order < 1 || power < 1) continue;
+    Term candidate{Number(1), t.factors, t.span};
+    candidate.factors[i].second -= 1;
+    Factor lower = f;
+    --lower.order;
+    candidate.factors.push_back({lower, 1});
+    candidate = ir::canonical(candidate);
+    auto derivative = differentiate(ir::canonical(std::vector<Term>{candidate}));
+    if (!derivative) continue;
+    // The term of the derivative that is t itself fixes the scale.
+    auto self = std::find_if(derivative->terms.begin(), derivative->terms.end(),
+                             [&](const Term& d) { return ir::compare_factors(d, t) == 0; });
+    if (self == derivative->terms.end()) continue;
+    const Number scale = t.coefficient / self->coefficient;
+    const Sum expected = ir::scale(*derivative, scale);
+    std::vector<Term> trial = remaining;
+    if (!std::all_of(expected.terms.begin(), expected.terms.end(), [&](const Term& d) { return take(trial, d); })) continue;
+    remaining = std::move(trial);
+    candidate.coefficient = scale;
+    return ir::canonical(std::vector<Term>{candidate});
+  }
+  return std::nullopt;
+}
+
+struct Integrator {
+  ir::Model& model;
+  Diagnostics& diagnostics;
+  int constants_made = 0;
+
+  std::string next_constant_name() {
+    std::string name;
+    do name = fmt::format("C{}", ++constants_made);
+    while (model.parameter_index(name) >= 0 || model.signal(name) || model.constants.count(name));
+    return name;
+  }
+
+  ir::Equation once(ir::Equation e, std::size_t equation_index) {
+    const bool initial = e.integration.constants == ir::IntegrationRequest::Constants::initial;
+    for (auto& term : e.terms) term.operation = antiderivative(term.operation, initial);
+    e.known = antiderivative(e.known, initial);
+    if (!initial) {  // eq. 2-2.4: the constant of this integration becomes a parameter
+      model.parameters.push_back({next_constant_name(), ir::Parameter::Origin::integration_constant, e.span,
+                                  static_cast<int>(equation_index)});
+      e.terms.push_back({static_cast<int>(model.parameters.size()) - 1, ir::number(1)});
+    }
+    ++e.integrations;
+    return e;
+  }
+
+  ir::Equation integrate(const ir::Equation& e, std::size_t index) {
+    const auto& r = e.integration;
+    const bool dynamic = is_dynamic(e.known) || std::any_of(e.terms.begin(), e.terms.end(),
+                                                            [](const ir::ParameterTerm& p) { return is_dynamic(p.operation); });
+    int times = r.times;
+    if (r.count == ir::IntegrationRequest::Count::automatic) {
+      // The smallest N that leaves the fewest derivatives to estimate (4-1.8 -> once, 2-2.6 -> twice).
+      const int highest = derivative_burden(e);
+      int best = highest;
+      times = 0;
+      ir::Model scratch = model;
+      Integrator trial{scratch, diagnostics, constants_made};
+      ir::Equation current = e;
+      for (int n = 1; n <= std::min(highest, kMaxIntegrations); ++n) {
+        current = trial.once(current, index);
+        if (const int b = derivative_burden(current); b < best) best = b, times = n;
+      }
+    } else if (times > kMaxIntegrations) {
+      diagnostics.add(diag::too_many_integrations(r.span.known() ? r.span : e.span, times, kMaxIntegrations));
+      return e;
+    }
+    if (times > 0 && !dynamic) {
+      diagnostics.add(diag::static_model_integrated(e.span, times));
+      return e;
+    }
+    ir::Equation out = e;
+    for (int n = 0; n < times; ++n) out = once(out, index);
+    // Done: the printed integrated model must not ask for integration again.
+    out.integration.count = ir::IntegrationRequest::Count::fixed;
+    out.integration.times = 0;
+    return out;
+  }
+};
+
+}  // namespace
+
+int derivative_burden(const ir::Equation& e) {
+  int b = burden(e.known);
+  for (const auto& p : e.terms) b = std::max(b, burden(p.operation));
+  return b;
+}
+
+Sum antiderivative(const Sum& s, bool initial) {
+  std::vector<Term> remaining = s.terms, result;
+  while (!remaining.empty()) {
+    const Term t = remaining.front();
+    if (auto exact = exact_antiderivative(t, remaining)) {
+      Sum piece = initial ? ir::subtract(*exact, at_window_start(*exact)) : *exact;
+      result.insert(result.end(), piece.terms.begin(), piece.terms.end());
+      continue;
+    }
+    remaining.erase(remaining.begin());
+    const Sum numeric = integral_of(ir::canonical(std::vector<Term>{t}));  // vanishes at t0
+    result.insert(result.end(), numeric.terms.begin(), numeric.terms.end());
+  }
+  return ir::canonical(std::move(result));
+}
+
+ir::Model integrate_pass(ir::Model model, const IntegrateOptions& options, Diagnostics& diagnostics) {
+  Integrator integrator{model, diagnostics};
+  std::vector<ir::Equation> equations = model.equations;
+  for (std::size_t i = 0; i < equations.size(); ++i) {
+    ir::Equation e = equations[i];
+    if (options.override_request) {
+      const auto constants = e.integration.constants;
+      e.integration = *options.override_request;
+      e.integration.constants = constants;
+    }
+    equations[i] = integrator.integrate(e, i);
+  }
+  model.equations = std::move(equations);
+  return model;
+}
+
+}  // namespace sidc

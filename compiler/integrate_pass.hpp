@@ -1,0 +1,37 @@
+// integrate_pass: equations rewritten into integrated form (thesis sections 2-1, 2-2, 4-1, 4-2).
+//
+// Relies on: normalize_pass (sum_k a_k op_k = known). Guarantees: each equation is integrated N
+// times from the start of the fit window t0 to t, N from its `integrate` setting, the
+// `--integrate` option, or `auto` (the smallest N leaving the fewest derivatives to estimate).
+// Each integration replaces a term by an exact antiderivative when one is found and checked (its
+// symbolic derivative must give back exactly the terms it replaces: y'' -> y', y^2*y' -> y^3/3
+// (eq. 2-2.7), y'*y'' -> y'^2/2, x'*y + x*y' -> x*y, constants -> tau), and otherwise by a
+// numerical integral `int(...)`, nested on repeated integration (eq. 2-2.5). Guarded terms are
+// never integrated symbolically. Integration constants become new parameters C1, C2, ... on
+// tau^(N-1)/(N-1)!, ..., tau, 1 (eqs. 2-1.5, 2-2.4, 2-2.5), or, with `constants = initial`, each
+// antiderivative has its value at t0 subtracted (eqs. 2-1.4, 4-2.4). Pinned by
+// tests/golden/integrated/.
+#pragma once
+
+#include <optional>
+
+#include "compiler/ir.hpp"
+#include "grammar/diagnostic.hpp"
+
+namespace sidc {
+
+struct IntegrateOptions {
+  // Overrides every equation's request when set (the command line's `--integrate N|auto`).
+  std::optional<ir::IntegrationRequest> override_request;
+};
+
+ir::Model integrate_pass(ir::Model model, const IntegrateOptions& options, Diagnostics& diagnostics);
+
+// One integration of a parameter-free sum from t0 to t, constants of integration dropped
+// (`initial` = false) or their values at t0 subtracted (`initial` = true).
+ir::Sum antiderivative(const ir::Sum& s, bool initial);
+
+// The highest derivative order anywhere in the equation, inside integrals and functions too.
+int derivative_burden(const ir::Equation& e);
+
+}  // namespace sidc

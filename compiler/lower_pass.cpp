@@ -1,0 +1,523 @@
+#include "compiler/lower_pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "compiler/differentiate.hpp"
+#include "compiler/print.hpp"
+#include "compiler/settings.hpp"
+#include "grammar/diagnostic_catalogue.hpp"
+
+namespace sidc {
+
+using ir::Factor;
+using ir::FactorKind;
+using ir::Sum;
+using ir::Term;
+
+std::pair<Term, Term> split_constant_part(const Term& t) {
+  Term constant{t.coefficient, {}, t.span}, rest{Number(1), {}, t.span};
+  for (const auto& item : t.factors) {
+    const bool constant_in_time = item.first.kind == FactorKind::parameter || item.first.is_constant_in_time();
+    (constant_in_time ? constant : rest).factors.push_back(item);
+  }
+  return {ir::canonical(constant), ir::canonical(rest)};
+}
+
+Sum integral_of(const Sum& s) {
+  std::vector<Term> terms;
+  for (const auto& t : s.terms) {
+    auto [constant, rest] = split_constant_part(t);
+    if (rest.factors.empty()) {  // int(1) = tau: the integral from t0 of a constant
+      rest.factors.push_back({Factor{FactorKind::elapsed, "", 0, {}, {}, {}, {}}, 1});
+    } else {
+      Factor f{FactorKind::integral, "", 0, {}, {}, ir::share(ir::canonical(std::vector<Term>{rest})), {}};
+      rest = Term{Number(1), {{f, 1}}, t.span};
+    }
+    terms.push_back(ir::multiply(constant, rest));
+  }
+  return ir::canonical(std::move(terms));
+}
+
+namespace {
+
+constexpr std::size_t kMaxTerms = 20000;
+
+// What an expression may refer to where it stands.
+struct Context {
+  bool parameters = false;  // equations
+  bool signals = false;     // equations
+  bool time = false;        // equations and input definitions
+  const char* what = "";    // for "... must be a number": "a constant", "an index"
+  std::string input;        // the input being defined, for its diagnostic
+};
+
+bool has_parameter(const Sum& s, std::string* name = nullptr) {
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors)
+      if (f.kind == FactorKind::parameter) {
+        if (name) *name = f.name;
+        return true;
+      }
+  return false;
+}
+
+Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
+
+struct Lowerer {
+  const ParseResult& parsed;
+  Diagnostics& diagnostics;
+  Declarations& decl;
+  std::map<std::string, Number> constants;
+  std::vector<std::pair<std::string, long long>> indices;  // sum indices in scope, innermost last
+  Context context;
+  bool failed = false;  // set by any error in the expression being lowered
+
+  Span span(const boost::spirit::x3::position_tagged& node) const { return parsed.span(node); }
+
+  void report(Diagnostic d) {
+    failed = true;
+    diagnostics.add(std::move(d));
+  }
+
+  std::vector<std::string> known_names() const {
+    std::vector<std::string> names{"t", "t0", "tau", "pi"};
+    for (const auto& [name, where] : decl.names) names.push_back(name);
+    for (const auto& p : decl.model.parameters) names.push_back(p.name);
+    for (const auto& [name, value] : indices) names.push_back(name);
+    return names;
+  }
+
+  std::optional<long long> index_value(const std::string& name) const {
+    for (auto it = indices.rbegin(); it != indices.rend(); ++it)
+      if (it->first == name) return it->second;
+    return std::nullopt;
+  }
+
+  Sum parameter(const std::string& name, const Span& where) {
+    int index = decl.model.parameter_index(name);
+    if (index < 0) {  // implicit: no `param` declaration in the file
+      decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1});
+      index = static_cast<int>(decl.model.parameters.size()) - 1;
+    }
+    return ir::factor(make(FactorKind::parameter, name, index), 1, where);
+  }
+
+  // ---- operands -------------------------------------------------------------------------------
+
+  Sum operator()(const ast::Number& n) {
+    auto value = Number::parse(n.text);
+    if (!value) {
+      report(diag::not_a_number(span(n), "this literal"));
+      return {};
+    }
+    return ir::number(*value, span(n));
+  }
+
+  Sum operator()(const ast::Variable& v) {
+    const std::string& name = v.name.name;
+    const int order = static_cast<int>(v.primes.size());
+    const Span where = span(v);
+    auto constant_value = [&](const Number& value) -> Sum {
+      if (order > 0) {
+        report(diag::derivative_of_constant(where, name));
+        return {};
+      }
+      return ir::number(value, where);
+    };
+    if (auto k = index_value(name)) return constant_value(Number(*k));
+    if (auto it = constants.find(name); it != constants.end()) return constant_value(it->second);
+    if (name == "pi") return constant_value(Number::real(M_PI));
+    if (name == "t" || name == "tau" || name == "t0") {
+      if (!context.time || (name != "t" && !context.signals)) return not_allowed(where, name);
+      if (name == "t0") return constant_value(Number(0)).empty() && failed ? Sum{} : ir::factor(make(FactorKind::window_start), 1, where);
+      Sum s = ir::factor(make(name == "t" ? FactorKind::time : FactorKind::elapsed), 1, where);
+      return order == 0 ? s : differentiate(s, order).value_or(Sum{});
+    }
+    if (const ir::Signal* s = decl.model.signal(name)) {
+      if (!context.signals) return not_allowed(where, name);
+      const_cast<ir::Signal*>(s)->used = true;
+      return ir::factor(make(FactorKind::signal, name, order), 1, where);
+    }
+    if (decl.families.count(name)) {
+      report(diag::family_needs_index(where, name));
+      return {};
+    }
+    if (is_function_name(name)) {
+      report(diag::wrong_arity(where, name, name == "der" ? "an expression and an order" : "one argument", 0));
+      return {};
+    }
+    const bool implicit = !decl.parameters_declared && decl.model.parameter_index(name) < 0;
+    if (implicit && order > 0) {  // differentiated, so meant as a signal: say so
+      report(diag::unknown_name(where, name, diag::nearest(name, known_names()), false));
+      return {};
+    }
+    if (decl.model.parameter_index(name) >= 0 || (!decl.parameters_declared && context.parameters)) {
+      if (!context.parameters) return not_allowed(where, name);
+      if (order > 0) {
+        report(diag::derivative_of_parameter(where, name));
+        return {};
+      }
+      return parameter(name, where);
+    }
+    report(diag::unknown_name(where, name, diag::nearest(name, known_names()), decl.parameters_declared));
+    return {};
+  }
+
+  // A name that exists but may not be used here (a signal in a constant, ...).
+  Sum not_allowed(const Span& where, const std::string& name) {
+    if (!context.input.empty()) report(diag::input_definition_uses_signal(where, context.input, name));
+    else report(diag::not_a_number(where, context.what));
+    return {};
+  }
+
+  Sum operator()(const ast::Signed& s) {
+    Sum operand = lower(s.operand);
+    return s.sign == '-' ? ir::negate(operand) : operand;
+  }
+
+  Sum operator()(const ast::Expression& e) { return lower(e); }
+
+  Sum operator()(const ast::Indexed& x) {
+    const std::string& name = x.name.name;
+    const Span where = span(x);
+    const bool implicit = !decl.parameters_declared && !decl.names.count(name) && !is_builtin_name(name);
+    if (!decl.families.count(name) && !implicit) {
+      report(diag::not_a_family(where, name, decl.model.signal(name) != nullptr));
+      return {};
+    }
+    const auto index = integer_of(x.index);
+    if (!index) return {};
+    if (auto it = decl.families.find(name); it != decl.families.end()) {
+      const auto [from, to] = it->second;
+      if (*index < from || *index > to) {
+        report(diag::index_out_of_range(where, name, *index, from, to));
+        return {};
+      }
+    }
+    if (!context.parameters) return not_allowed(where, name);
+    return parameter(fmt::format("{}[{}]", name, *index), where);
+  }
+
+  std::optional<long long> integer_of(const ast::Expression& e) {
+    const Context saved = context;
+    context = Context{false, false, false, "an index", {}};
+    const bool failed_before = failed;
+    failed = false;
+    Sum s = lower(e);
+    const bool bad = failed;
+    failed = failed_before || bad;
+    context = saved;
+    if (bad) return std::nullopt;
+    auto n = s.as_number();
+    if (!n || !n->is_integer()) {
+      report(diag::index_not_integer(span(e)));
+      return std::nullopt;
+    }
+    return n->numerator();
+  }
+
+  Sum operator()(const ast::Guard& g) {
+    Factor f = make(FactorKind::guard);
+    for (const auto& c : g.conditions) {
+      Sum lhs = lower(c.lhs), rhs = lower(c.rhs);
+      std::string name;
+      if (has_parameter(lhs, &name) || has_parameter(rhs, &name)) {
+        report(diag::nonlinear_parameter(span(c), name, "it stands inside a guard `[...]`"));
+        return {};
+      }
+      ir::Relation r = c.op == "<" ? ir::Relation::less
+                     : c.op == "<=" ? ir::Relation::less_equal
+                     : c.op == ">" ? ir::Relation::greater : ir::Relation::greater_equal;
+      // `0 >= y'` reads as `y' <= 0`: the same region, one canonical spelling.
+      if (lhs.as_number() && !rhs.as_number()) {
+        std::swap(lhs, rhs);
+        r = r == ir::Relation::less ? ir::Relation::greater
+          : r == ir::Relation::less_equal ? ir::Relation::greater_equal
+          : r == ir::Relation::greater ? ir::Relation::less : ir::Relation::less_equal;
+      }
+      f.conditions.push_back({ir::share(std::move(lhs)), r, ir::share(std::move(rhs))});
+    }
+    std::sort(f.conditions.begin(), f.conditions.end(), [](const ir::Condition& a, const ir::Condition& b) {
+      Factor x = make(FactorKind::guard), y = make(FactorKind::guard);
+      x.conditions = {a};
+      y.conditions = {b};
+      return ir::compare(x, y) < 0;
+    });
+    if (!context.signals) return not_allowed(span(g), "[...]");
+    return ir::factor(std::move(f), 1, span(g));
+  }
+
+  Sum operator()(const ast::SumOver& s) {
+    const std::string& name = s.index.name;
+    const Span where = span(s);
+    if (decl.names.count(name) || is_builtin_name(name) || index_value(name) || decl.model.parameter_index(name) >= 0) {
+      report(diag::index_shadows(span(s.index), name));
+      return {};
+    }
+    if (s.from > s.to) {
+      report(diag::bad_range(where, s.from, s.to));
+      return {};
+    }
+    if (static_cast<long long>(s.to) - s.from + 1 > kMaxFamilySize) {
+      report(diag::range_too_large(where, static_cast<long long>(s.to) - s.from + 1, kMaxFamilySize));
+      return {};
+    }
+    std::vector<Term> terms;
+    for (long long k = s.from; k <= s.to; ++k) {
+      indices.emplace_back(name, k);
+      Sum body = lower(s.body);
+      indices.pop_back();
+      if (failed) return {};
+      if (terms.size() + body.terms.size() > kMaxTerms) {
+        report(diag::expression_too_large(where, kMaxTerms));
+        return {};
+      }
+      terms.insert(terms.end(), body.terms.begin(), body.terms.end());
+    }
+    return ir::canonical(std::move(terms));
+  }
+
+  Sum operator()(const ast::Call& c) {
+    const std::string& name = c.callee.name.name;
+    const Span where = span(c);
+    const int primes = static_cast<int>(c.callee.primes.size());
+    if (const ir::Signal* s = decl.model.signal(name)) return initial_value(c, *s, primes);
+    if (!is_function_name(name)) {
+      if (decl.names.count(name) || decl.model.parameter_index(name) >= 0 || index_value(name) || is_builtin_name(name)) {
+        const char* what = decl.model.parameter_index(name) >= 0 ? "a parameter" : "a constant";
+        report(diag::not_callable(where, name, what));
+      } else {
+        std::vector<std::string> candidates = function_names();
+        for (const auto& sig : decl.model.signals) candidates.push_back(sig.name);
+        report(diag::unknown_function(span(c.callee), name, diag::nearest(name, candidates)));
+      }
+      return {};
+    }
+    if (primes > 0) {
+      report(diag::not_callable(where, name + c.callee.primes, "a derivative of a function"));
+      return {};
+    }
+    if (name == "der") return derivative(c);
+    if (c.arguments.size() != 1) {
+      report(diag::wrong_arity(where, name, "one argument", c.arguments.size()));
+      return {};
+    }
+    Sum argument = lower(c.arguments[0]);
+    if (failed) return {};
+    std::string parameter_name;
+    if (name == "int") {
+      if (!context.signals) return not_allowed(where, "int");
+      return integral_of(argument);
+    }
+    if (has_parameter(argument, &parameter_name)) {
+      report(diag::nonlinear_parameter(where, parameter_name, fmt::format("it stands inside `{}(...)`", name)));
+      return {};
+    }
+    if (auto n = argument.as_number()) return apply_to_number(name, *n, where);
+    return ir::factor(Factor{FactorKind::function, name, 0, {}, {}, ir::share(std::move(argument)), {}}, 1, where);
+  }
+
+  Sum apply_to_number(const std::string& name, const Number& n, const Span& where) {
+    if (name == "abs") return ir::number(n.abs(), where);
+    if (name == "sign") return ir::number(Number(n.is_zero() ? 0 : (n.is_negative() ? -1 : 1)), where);
+    const double x = n.value();
+    const double y = name == "sin" ? std::sin(x) : name == "cos" ? std::cos(x) : name == "exp" ? std::exp(x)
+                   : name == "log" ? std::log(x) : name == "sqrt" ? std::sqrt(x) : std::tanh(x);
+    if (!std::isfinite(y)) {
+      report(diag::not_a_number(where, fmt::format("`{}({})`", name, n.to_string())));
+      return {};
+    }
+    if (y == 0.0) return {};
+    return ir::number(Number::real(y), where);
+  }
+
+  Sum initial_value(const ast::Call& c, const ir::Signal& s, int order) {
+    const Span where = span(c);
+    if (c.arguments.size() != 1) {
+      report(diag::bad_initial_value(where, s.name));
+      return {};
+    }
+    Factor f = make(FactorKind::initial_value, s.name, order);
+    // `y(t0)`: at the start of the fit window; otherwise a constant time.
+    const auto& arg = c.arguments[0];
+    const auto* variable = arg.rest.empty() ? boost::get<ast::Variable>(&arg.first.get()) : nullptr;
+    if (!(variable && variable->name.name == "t0" && variable->primes.empty())) {
+      const Context saved = context;
+      context = Context{false, false, false, "the time of an initial value", {}};
+      Sum at = lower(arg);
+      context = saved;
+      auto n = at.as_number();
+      if (failed || !n) {
+        if (!failed) report(diag::bad_initial_value(where, s.name));
+        return {};
+      }
+      f.at = *n;
+    }
+    if (!context.signals) return not_allowed(where, s.name);
+    const_cast<ir::Signal&>(s).used = true;
+    return ir::factor(std::move(f), 1, where);
+  }
+
+  Sum derivative(const ast::Call& c) {
+    const Span where = span(c);
+    if (c.arguments.empty() || c.arguments.size() > 2) {
+      report(diag::wrong_arity(where, "der", "an expression and an order", c.arguments.size()));
+      return {};
+    }
+    int order = 1;
+    if (c.arguments.size() == 2) {
+      const auto n = integer_of(c.arguments[1]);
+      if (!n) return {};
+      if (*n < 1 || *n > 16) {
+        report(diag::bad_derivative_order(span(c.arguments[1])));
+        return {};
+      }
+      order = static_cast<int>(*n);
+    }
+    Sum argument = lower(c.arguments[0]);
+    if (failed) return {};
+    // der() is linear: parameters and other constants in time come outside.
+    std::vector<Term> terms;
+    for (const auto& t : argument.terms) {
+      auto [constant, rest] = split_constant_part(t);
+      if (rest.factors.empty()) {
+        std::string name;
+        if (has_parameter(ir::canonical(std::vector<Term>{constant}), &name)) {
+          report(diag::derivative_of_parameter(where, name));
+          return {};
+        }
+        continue;  // the derivative of a constant is zero
+      }
+      const Sum inner = ir::canonical(std::vector<Term>{rest});
+      Sum d;
+      if (auto symbolic = differentiate(inner, order)) d = std::move(*symbolic);
+      else d = ir::factor(Factor{FactorKind::derivative, "", order, {}, {}, ir::share(inner), {}}, 1, where);
+      for (const auto& x : d.terms) terms.push_back(ir::multiply(constant, x));
+    }
+    return ir::canonical(std::move(terms));
+  }
+
+  Sum lower(const ast::Operand& operand) { return boost::apply_visitor(*this, operand); }
+
+  Sum lower(const ast::Expression& e) {
+    Sum result = lower(e.first);
+    if (e.rest.empty()) return result;
+    if (e.rest.front().op == '+' || e.rest.front().op == '-') {
+      // Additive chains are gathered and made canonical once: a 10 MB line of `y+y+...` stays linear.
+      std::vector<Term> terms = std::move(result.terms);
+      for (const auto& step : e.rest) {
+        Sum operand = lower(step.operand);  // after an error, go on: the other terms may have theirs
+        if (step.op == '-') operand = ir::negate(operand);
+        terms.insert(terms.end(), operand.terms.begin(), operand.terms.end());
+      }
+      if (failed) return {};
+      return ir::canonical(std::move(terms));
+    }
+    for (const auto& step : e.rest) {
+      Sum operand = lower(step.operand);
+      if (failed) continue;  // lower the remaining factors too, for their errors
+      const Span where = span(step);
+      if (step.op == '*') {
+        if (result.terms.size() * operand.terms.size() > kMaxTerms) {
+          report(diag::expression_too_large(where, kMaxTerms));
+          return {};
+        }
+        result = ir::multiply(result, operand);
+      } else if (step.op == '/') {
+        std::string name;
+        if (has_parameter(operand, &name)) {
+          report(diag::nonlinear_parameter(where, name, "it stands in a denominator"));
+          return {};
+        }
+        if (auto n = operand.as_number()) {
+          if (n->is_zero()) {
+            report(diag::division_by_zero(where));
+            return {};
+          }
+          result = ir::scale(result, Number(1) / *n);
+        } else {
+          result = ir::multiply(result, reciprocal(operand));
+        }
+      } else {  // '^'
+        std::string name;
+        if (has_parameter(operand, &name)) {
+          report(diag::nonlinear_parameter(where, name, "it stands in an exponent"));
+          return {};
+        }
+        auto exponent = operand.as_number();
+        if (!exponent) {
+          report(diag::exponent_not_constant(where));
+          return {};
+        }
+        if (has_parameter(result, &name) && !exponent->is_one()) {
+          report(diag::nonlinear_parameter(where, name, fmt::format("it is raised to the power {}", exponent->to_string())));
+          return {};
+        }
+        if (auto base = result.as_number(); base && !(base->is_zero() && exponent->is_negative())) {
+          result = exponent->is_integer() ? ir::number(base->pow(exponent->numerator()), where)
+                                          : ir::number(Number::real(std::pow(base->value(), exponent->value())), where);
+          continue;
+        }
+        if (result.empty() && exponent->is_negative()) {
+          report(diag::division_by_zero(where));
+          return {};
+        }
+        auto raised = raise(result, *exponent, kMaxTerms);
+        if (!raised) {
+          report(diag::expression_too_large(where, kMaxTerms));
+          return {};
+        }
+        result = std::move(*raised);
+      }
+    }
+    if (failed) return {};
+    return result;
+  }
+
+  // Lowers one top-level expression in a context; nullopt after an error in it.
+  std::optional<Sum> lower_in(const ast::Expression& e, Context c) {
+    context = std::move(c);
+    failed = false;
+    Sum s = lower(e);
+    if (failed) return std::nullopt;
+    return s;
+  }
+};
+
+}  // namespace
+
+LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Diagnostics& diagnostics) {
+  Lowerer l{parsed, diagnostics, declarations, {}, {}, {}, false};
+  for (const auto& c : declarations.constants) {
+    auto value = l.lower_in(*c.value, Context{false, false, false, "a constant", {}});
+    if (!value) continue;
+    if (auto n = value->as_number()) l.constants.emplace(c.name, *n);
+    else diagnostics.add(diag::not_a_number(l.span(*c.value), fmt::format("constant `{}`", c.name)));
+  }
+  for (const auto& d : declarations.input_definitions) {
+    auto& signal = declarations.model.signals[d.signal];
+    if (auto value = l.lower_in(*d.definition, Context{false, false, true, "an input definition", signal.name}))
+      signal.definition = std::move(*value);
+  }
+  LoweredModel out;
+  for (const auto& pending : declarations.equations) {
+    const ast::Equation& e = *pending.equation;
+    auto lhs = l.lower_in(e.lhs, Context{true, true, true, "", {}});
+    auto rhs = l.lower_in(e.rhs, Context{true, true, true, "", {}});
+    if (lhs && rhs) out.equations.push_back({parsed.span(e), std::move(*lhs), std::move(*rhs), pending.integration});
+  }
+  if (declarations.equations.empty() && !diagnostics.has_errors())
+    diagnostics.add(diag::empty_model(Span{parsed.source, 0, 0}));
+  for (const auto& s : declarations.model.signals) {
+    if (s.used || (s.definition && false)) continue;
+    if (diagnostics.has_errors()) break;  // an earlier error may be why it looks unused
+    diagnostics.add(s.kind == ir::Signal::Kind::output ? diag::output_unused(s.span, s.name) : diag::input_unused(s.span, s.name));
+  }
+  out.model = std::move(declarations.model);
+  out.model.constants = std::move(l.constants);
+  return out;
+}
+
+}  // namespace sidc

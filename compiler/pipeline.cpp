@@ -1,0 +1,47 @@
+// The table of contents of the compiler: each pass, in order, with the reason for its place.
+// docs/architecture.md maps each to its file and to the flag that prints its result
+// (`sidc compile --dump-after=PASS`).
+#include "compiler/pipeline.hpp"
+
+#include "compiler/declare_pass.hpp"
+#include "compiler/lower_pass.hpp"
+#include "compiler/normalize_pass.hpp"
+#include "compiler/print.hpp"
+
+namespace sidc {
+
+const std::vector<PassInfo>& passes() {
+  static const std::vector<PassInfo> list{
+      {"parse", "text to AST; first, as everything else reads the tree (grammar/parse.cpp)"},
+      {"declare", "names, families, settings and data bindings; before lowering, which resolves names against them"},
+      {"lower", "expressions to canonical sums; needs every name declared, and gives normalize plain factors"},
+      {"normalize", "the thesis' linear form sum a_k op_k = known; needs canonical sums to find like terms"},
+      {"integrate", "integrated form (sections 2-1, 2-2); works on the linear form, one operation at a time"},
+  };
+  return list;
+}
+
+CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOptions& options) {
+  CompileResult r;
+  auto stop = [&](const char* pass) {
+    r.last_pass = pass;
+    return options.stop_after == pass || r.diagnostics.has_errors();
+  };
+  r.parsed = parse_model(std::move(source));
+  r.diagnostics = r.parsed.diagnostics;
+  if (stop("parse")) return r;
+  Declarations declarations = declare_pass(r.parsed, r.diagnostics);
+  if (stop("declare")) return r;
+  LoweredModel lowered = lower_pass(std::move(declarations), r.parsed, r.diagnostics);
+  for (const auto& e : lowered.equations) r.lowered_text += print(e.lhs) + " = " + print(e.rhs) + "\n";
+  // Errors in some equations still let the others be normalized, for a fuller report in one run.
+  r.last_pass = "lower";
+  if (options.stop_after == "lower") return r;
+  r.normalized = normalize_pass(std::move(lowered), r.diagnostics);
+  if (stop("normalize")) return r;
+  r.integrated = integrate_pass(*r.normalized, options.integrate, r.diagnostics);
+  stop("integrate");
+  return r;
+}
+
+}  // namespace sidc

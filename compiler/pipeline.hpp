@@ -1,0 +1,39 @@
+// The compiler's passes in order, and `compile`, which runs them.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compiler/integrate_pass.hpp"
+#include "compiler/ir.hpp"
+#include "grammar/parse.hpp"
+
+namespace sidc {
+
+struct PassInfo {
+  const char* name;
+  const char* reason;  // why it stands where it does
+};
+// parse, declare, lower, normalize, integrate: see pipeline.cpp.
+const std::vector<PassInfo>& passes();
+
+struct CompileOptions {
+  IntegrateOptions integrate;
+  std::string stop_after;  // a pass name: stop there (for --dump-after); empty = run them all
+};
+
+struct CompileResult {
+  ParseResult parsed;
+  std::optional<ir::Model> normalized;  // after normalize_pass
+  std::optional<ir::Model> integrated;  // after integrate_pass: what `sidc fit` solves
+  std::string last_pass;                // the last pass that ran
+  Diagnostics diagnostics;
+  std::string lowered_text;             // lower_pass's equations, printed, for --dump-after=lower
+  bool ok() const { return !diagnostics.has_errors(); }
+};
+
+CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOptions& options);
+
+}  // namespace sidc

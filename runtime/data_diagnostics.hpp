@@ -1,0 +1,71 @@
+// Every message sidc prints about a data file (a record), one named constructor each, the data
+// counterpart of grammar/diagnostic_catalogue.hpp. records.cpp and sampling.cpp build
+// Diagnostics only through these, so the wording lives in one place and the bad-record tests
+// (tests/runtime/bad_records_test.cpp, files in tests/data/bad/) pin every one of them.
+//
+// Locations are `file:row:col` with row = 1-based line number in the file (comments, blank lines
+// and the header count) and col = 1-based field index on that line. Codes are stable: tests and
+// the JSON output use them. A problem with no sensible location (the file cannot be opened)
+// carries no data_file and names the path in its message instead.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "grammar/diagnostic.hpp"
+
+namespace sidc::data_diag {
+
+// What is wrong with one cell of a numeric column.
+enum class CellFault : unsigned char {
+  none,
+  empty,          // nothing between the separators
+  not_a_number,   // the text `nan` (any case)
+  infinite,       // `inf`, `-Infinity`, ...
+  non_numeric,    // text that is not a number at all
+  decimal_comma,  // `1,5` in a semicolon or blank separated file
+  out_of_range,   // beyond the range of a double (1e400)
+};
+
+// ---- the file as a whole (records.cpp) ---------------------------------------------------------
+Diagnostic cannot_open(std::string_view path, std::string_view reason);
+Diagnostic is_directory(std::string_view path);
+Diagnostic empty_file(std::string_view path);
+Diagnostic binary_file(std::string_view path, int row, int column);
+Diagnostic no_data_rows(std::string_view path, int header_row);
+Diagnostic invalid_csv_options(std::string_view why);
+
+// ---- the header (records.cpp) ------------------------------------------------------------------
+Diagnostic unterminated_quote(std::string_view path, int row, int column);
+Diagnostic duplicate_column(std::string_view path, int row, int column, std::string_view name, int first_column);
+
+// ---- row shape (records.cpp) -------------------------------------------------------------------
+Diagnostic too_many_fields(std::string_view path, int row, int column, std::size_t expected, bool blank_separated);
+Diagnostic too_few_fields(std::string_view path, int row, int column, std::size_t found, std::size_t expected,
+                          bool blank_separated);
+
+// ---- a used column (records.cpp) ---------------------------------------------------------------
+// `text` is the cell as written (may be empty when it is not known); it is shown sanitised.
+Diagnostic bad_cell(std::string_view path, int row, int column, std::string_view column_name, CellFault fault,
+                    std::string_view text);
+Diagnostic unknown_column(std::string_view path, int header_row, std::string_view name,
+                          const std::vector<std::string>& names);
+
+// ---- the time column (sampling.cpp) ------------------------------------------------------------
+Diagnostic too_few_samples(std::string_view path, int row, int column, std::string_view name, std::size_t count);
+Diagnostic time_repeats(std::string_view path, int row, int column, std::string_view name, double value);
+Diagnostic time_goes_backwards(std::string_view path, int row, int column, std::string_view name, double previous,
+                               double value);
+Diagnostic time_step_not_uniform(std::string_view path, int row, int column, std::string_view name, double found,
+                                 double expected, double relative_tolerance);
+Diagnostic invalid_resampling_step(double step);
+Diagnostic empty_time_window(std::string_view path, std::string_view name, double from, double to, double first,
+                             double last);
+
+// ---- signal operations (savitzky_golay.cpp, simpson.cpp); no location: the caller adds the
+// span of the model term that asked for the operation ---------------------------------------------
+Diagnostic invalid_signal_options(std::string_view operation, std::string_view why);
+Diagnostic signal_shorter_than_window(std::size_t samples, int window);
+
+}  // namespace sidc::data_diag

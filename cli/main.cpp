@@ -6,6 +6,7 @@
 
 #include "cli/compile_command.hpp"
 #include "cli/exit_codes.hpp"
+#include "cli/fit_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"sidc: identify the parameters and operations of dynamic systems from recorded data\n"
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   int exit_status = sidc::exit_code::success;
   try {
     sidc::add_compile_command(app, exit_status);
+    sidc::add_fit_command(app, exit_status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -67,7 +67,7 @@ std::string magnitude(const ir::Term& t) {
 
 // Breaks a long equation after top-level ` + `, ` - ` or ` = ` (the grammar continues a statement
 // after a trailing operator), filling lines up to `width` characters; continuation lines indented.
-std::string wrap(const std::string& text, std::size_t width = 100) {
+std::string wrap(const std::string& text, std::size_t width = 100, std::size_t indent_width = 4) {
   if (text.size() <= width) return text;
   std::vector<std::size_t> breaks;  // positions just after "+ ", "- " or "= " at depth 0
   int depth = 0;
@@ -79,7 +79,7 @@ std::string wrap(const std::string& text, std::size_t width = 100) {
   }
   std::string out;
   std::size_t line_start = 0, last_fit = 0;
-  const std::string indent = "    ";
+  const std::string indent(indent_width, ' ');
   for (std::size_t b : breaks) {
     const std::size_t limit = width - (line_start == 0 ? 0 : indent.size());
     if (b - line_start > limit && last_fit > line_start) {
@@ -154,6 +154,10 @@ std::string print(const ir::Equation& e, const ir::Model& m) {
     else lhs += (negative ? " - " : " + ") + text;
   }
   return lhs + " = " + print(e.known);
+}
+
+std::string print_wrapped(const ir::Equation& e, const ir::Model& m, std::size_t width, std::size_t indent) {
+  return wrap(print(e, m), width, indent);
 }
 
 std::string print(const ir::Model& m) {

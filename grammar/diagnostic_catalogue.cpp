@@ -387,6 +387,33 @@ Diagnostic integrate_option_invalid(std::string_view value) {
 Diagnostic no_signal(const Span& where) {
   return error("no-signal", where, "this equation uses no signal", "an equation relates signals, e.g. `a1*y' + a2*y = x`");
 }
+Diagnostic operation_not_finite(const Span& where, std::string_view operation, double time, std::string_view record) {
+  return error("operation-not-finite", where,
+               fmt::format("`{}` is not a finite number at t = {} in `{}`", operation, time, record),
+               "check the record there (a zero under a division or a log, a huge power), or narrow the fit window with `set from`/`set to`");
+}
+
+Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record) {
+  return error("initial-value-unavailable", where, fmt::format("`{}` has no value at t = {} in `{}`", value, time, record),
+               "a derivative has no estimate near the edges of the record under `edges = drop`; use a later time or `set edges = shorten`");
+}
+
+Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last) {
+  return error("initial-value-outside-record", where, fmt::format("`{}` asks for t = {}, outside the record ({} to {})", value, time, first, last),
+               "give a time within the record");
+}
+
+Diagnostic no_data_file(const Span& where) {
+  return error("no-data-file", where, "the model names no record to fit",
+               "add `data \"record.csv\"` to the model, or give one with `sidc fit --data record.csv`");
+}
+
+Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin) {
+  return error("window-too-short", {},
+               fmt::format("`{}` leaves {} rows in the fit window for {} parameters", record, rows, parameters),
+               fmt::format("the moving-arc derivatives lose {} samples at each edge; use a longer record, a wider window "
+                           "(`set from`/`set to`), fewer parameters, or `set edges = shorten`", margin));
+}
 // [end of compiler-owned section]
 
 }  // namespace sidc::diag

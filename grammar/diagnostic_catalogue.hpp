@@ -122,6 +122,12 @@ Diagnostic too_many_integrations(const Span& where, int times, int limit);
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes);
 Diagnostic integrate_option_invalid(std::string_view value);
 Diagnostic no_signal(const Span& where);
+// ---- evaluation on data (runtime/), pointing at the model text
+Diagnostic operation_not_finite(const Span& where, std::string_view operation, double time, std::string_view record);
+Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);
+Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last);
+Diagnostic no_data_file(const Span& where);
+Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin);
 // [end of compiler-owned section]
 
 }  // namespace sidc::diag

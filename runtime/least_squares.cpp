@@ -684,7 +684,8 @@ std::string LeastSquaresSummary::full_report() const {
     text += fmt::format("  {:<30} {}\n", label, value);
   };
   text += "Least squares: QR with column pivoting (Householder), thesis eqs. 2-1.6 to 2-1.8\n";
-  line("termination", to_string(termination) + (message.empty() ? std::string() : ": " + message));
+  line("termination", message.empty() ? std::string(to_string(termination))
+                                      : fmt::format("{}: {}", to_string(termination), message));
   if (termination == Termination::invalid_input || termination == Termination::too_few_rows) return text;
   line("rows n (non-zero weight)", fmt::format("{}", n));
   line("parameters p, rank", fmt::format("{}, {} (pivot tolerance {:.3g} x |R11|)", p, rank, rank_tolerance_used));

@@ -49,7 +49,7 @@ enum class Precision {
   automatic,         // extended when the problem is small (n * p^2 <= extended_work_limit), else double
   double_precision,  // QR in double, residuals in long double (fast: the choice for large n)
   extended,          // QR in long double (64-bit mantissa), residuals in quad (113 bits);
-                     // about 3 times the QR time of double plus ~0.1 us per row and column per step
+                     // about 6 times the time of double (n = 2000, p = 25: 44 ms against 7 ms)
 };
 
 struct LeastSquaresOptions {
@@ -83,7 +83,7 @@ struct LeastSquaresOptions {
 
   Precision precision = Precision::automatic;
   // The work n * p^2 up to which Precision::automatic chooses extended (at the limit, e.g.
-  // n = 1600, p = 25, extended costs about 40 ms against 6 ms for double); beyond it, double.
+  // n = 1600, p = 25, extended costs about 35 ms against 6 ms for double); beyond it, double.
   double extended_work_limit = 1e6;
 
   double confidence_level = 0.95;  // two-sided, for ParameterEstimate::ci_low / ci_high
@@ -102,7 +102,7 @@ struct ParameterEstimate {
 struct LeastSquaresSummary {
   enum class Termination { success, rank_deficient, invalid_input, too_few_rows };
   Termination termination = Termination::invalid_input;
-  std::string message;  // why, when not success (e.g. "weight of row 12 is negative (-1)")
+  std::string message;  // why, when not success (e.g. "weight of row 13 is -1 (weights must be ...)")
 
   std::size_t n = 0;     // rows with non-zero weight
   std::size_t p = 0;     // columns
@@ -145,8 +145,9 @@ struct LeastSquaresSummary {
   bool columns_scaled = false;
   bool columns_centred = false;
   int refinement_steps_taken = 0;
-  // max_j |x_j - x0_j| / max_j |x_j|: how far refinement moved the plain QR solution x0; its
-  // -log10 is roughly the number of correct digits x0 had. 0 when refinement is off.
+  // max over non-zero x_j of |x_j - x0_j| / |x_j|: how far refinement moved the plain QR
+  // solution x0; its -log10 is roughly the number of correct digits the worst parameter of x0
+  // had. 0 when refinement is off.
   double refinement_change = 0;
   double rank_tolerance_used = 0;
 

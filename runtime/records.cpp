@@ -1,7 +1,10 @@
 // CSV reading: one read of the whole file, then one pass over the bytes. The fast path per cell
-// is std::from_chars straight on the buffer (it stops at the separator by itself), so a cell
-// costs one number conversion and a comparison; everything unusual (quotes, `+`, `D` exponents,
-// decimal commas, text, NaN) falls to a slow path that looks at the cell's text.
+// reads the number straight off the buffer (read_simple_number, else std::from_chars; both stop
+// at the separator by themselves), so a cell costs one conversion and a comparison; everything
+// unusual (quotes, `+`, `D` exponents, decimal commas, text, NaN) falls to a slow path that
+// looks at the cell's text. Measured on a
+// 10^7-row, 4-column, 426 MB file (2-core VM, -O2): about 28 M values/s and 300 MB/s in CPU
+// time for read_csv, 34 M values/s for parse_csv on text already in memory.
 #include "runtime/records.hpp"
 
 #include <algorithm>

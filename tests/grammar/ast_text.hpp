@@ -41,7 +41,8 @@ inline std::string text(const ast::Operand& operand) {
 
 inline std::string text(const ast::Expression& e) {
   if (e.rest.empty()) return text(e.first);
-  std::string out = "(" + text(e.first);
+  std::string out = "(";
+  out += text(e.first);
   for (const auto& operation : e.rest) out += std::string(" ") + operation.op + " " + text(operation.operand);
   return out + ")";
 }
@@ -62,8 +63,13 @@ inline std::string text(const ast::Statement& statement) {
       std::string out = "param";
       for (std::size_t i = 0; i < d.parameters.size(); ++i) {
         out += (i ? ", " : " ") + d.parameters[i].name.name;
-        if (d.parameters[i].from)
-          out += "[" + std::to_string(*d.parameters[i].from) + ".." + std::to_string(d.parameters[i].to.value_or(-999)) + "]";
+        if (d.parameters[i].from) {
+          out += '[';
+          out += std::to_string(*d.parameters[i].from);
+          out += "..";
+          out += std::to_string(d.parameters[i].to.value_or(-999));
+          out += ']';
+        }
       }
       return out;
     }

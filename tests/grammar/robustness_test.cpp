@@ -223,7 +223,7 @@ TEST(Robustness, MutatedModelsNeverThrowAndPointInsideTheText) {
         case 1: text.insert(at, 1, alphabet[random() % alphabet.size()]); break;
         default: text.insert(at, text.substr(random() % text.size(), 1 + random() % 8)); break;
       }
-      if (text.empty()) text = "z";
+      if (text.empty()) text.push_back('z');
     }
     ParseResult result;
     ASSERT_NO_THROW(result = parse_text(text)) << text;

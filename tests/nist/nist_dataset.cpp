@@ -8,6 +8,8 @@
 #include <regex>
 #include <sstream>
 
+#include <fmt/format.h>
+
 namespace sidc::nist {
 namespace {
 
@@ -96,13 +98,13 @@ Dataset read_dataset(const std::string& path) {
     for (const std::string& token : tokens) {
       double value = 0;
       if (!parse_number(token, value)) {
-        dataset.error = "line " + std::to_string(number) + ": '" + token + "' is not a number";
+        dataset.error = fmt::format("line {}: '{}' is not a number", number, token);
         return dataset;
       }
       values.push_back(value);
     }
     if (values.size() < 2 || (!dataset.x.empty() && values.size() != dataset.x.front().size() + 1)) {
-      dataset.error = "line " + std::to_string(number) + " has the wrong number of columns";
+      dataset.error = fmt::format("line {} has the wrong number of columns", number);
       return dataset;
     }
     dataset.y.push_back(values.front());

@@ -24,7 +24,8 @@ using Termination = LeastSquaresSummary::Termination;
 
 std::vector<std::string> names_of(int p) {
   std::vector<std::string> names;
-  for (int j = 0; j < p; ++j) names.push_back("a" + std::to_string(j + 1));
+  // (Not "a" + std::to_string(...): GCC 12 warns -Wrestrict on it, a false positive.)
+  for (int j = 0; j < p; ++j) names.push_back(std::string("a").append(std::to_string(j + 1)));
   return names;
 }
 

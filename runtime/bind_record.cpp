@@ -1,0 +1,96 @@
+#include "runtime/bind_record.hpp"
+
+#include <fmt/format.h>
+
+namespace sidc {
+namespace {
+
+std::string column_for(const ir::DataSource& source, const std::string& signal) {
+  for (const auto& [name, column] : source.bindings)
+    if (name == signal) return column;
+  return signal;
+}
+
+bool bound(const ir::DataSource& source, const std::string& signal) {
+  for (const auto& [name, column] : source.bindings)
+    if (name == signal) return true;
+  return false;
+}
+
+}  // namespace
+
+std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const ir::DataSource& source,
+                                                    const ir::Model& model, const BindOptions& options) {
+  SampledRecord out;
+  out.path = record.path;
+  const std::size_t rows = record.rows();
+
+  // The time grid.
+  std::string time_column;
+  if (bound(source, "t")) time_column = column_for(source, "t");
+  else if (record.column("t")) time_column = "t";
+  else if (record.column("time")) time_column = "time";
+  std::vector<double> time;
+  if (!time_column.empty() && !options.step) {
+    auto column = complete_column(record, time_column);
+    if (auto* d = std::get_if<Diagnostic>(&column)) return *d;
+    time = *std::get<const std::vector<double>*>(column);
+    if (!options.resample) {
+      auto step = uniform_step(record, time_column, options.uniform);
+      if (auto* d = std::get_if<Diagnostic>(&step)) return *d;
+      out.step = std::get<double>(step);
+    }
+  } else if (options.step) {
+    out.step = *options.step;
+    time.resize(rows);
+    for (std::size_t k = 0; k < rows; ++k) time[k] = static_cast<double>(k) * out.step;
+  } else {
+    Diagnostic d;
+    d.code = "no-time-column";
+    d.data_file = record.path;
+    d.row = record.header_line > 0 ? record.header_line : 1;
+    d.column = 1;
+    d.message = "the record has no time column (`t` or `time`) and no sampling step was given";
+    d.hint = "bind one in the model (`data \"" + record.path + "\" (t = \"seconds\")`), or give the step with `set step = 0.01` or `--step 0.01`";
+    return d;
+  }
+
+  // The signals read from columns.
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  for (const auto& s : model.signals) {
+    if (s.definition) continue;
+    const std::string column = column_for(source, s.name);
+    auto values = complete_column(record, column);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    names.push_back(s.name);
+    columns.push_back(*std::get<const std::vector<double>*>(values));
+    out.columns[s.name] = column;
+  }
+
+  if (options.resample) {
+    if (!(*options.resample > 0)) return data_diag::invalid_resampling_step(*options.resample);
+    ResampledSignals r = resample_linear(time, columns, *options.resample);
+    time = std::move(r.time);
+    columns = std::move(r.columns);
+    out.step = *options.resample;
+  }
+
+  const std::size_t every = static_cast<std::size_t>(std::max(1, options.every));
+  out.time = decimate(time, every);
+  out.step *= static_cast<double>(every);
+  for (std::size_t i = 0; i < names.size(); ++i) out.signals[names[i]] = decimate(columns[i], every);
+
+  // Inputs given as expressions of t (the thesis' x = 60 sin 4 pi t), evaluated on the grid.
+  for (const auto& s : model.signals) {
+    if (!s.definition) continue;
+    Evaluator evaluator(out, model, EvaluationOptions{}, FitWindow{0, out.time.size() ? out.time.size() - 1 : 0});
+    auto values = evaluator.evaluate(*s.definition);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    out.signals[s.name] = std::get<std::vector<double>>(std::move(values));
+    out.columns[s.name] = "(defined in the model)";
+  }
+  return out;
+}
+
+}  // namespace sidc

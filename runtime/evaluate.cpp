@@ -1,0 +1,277 @@
+#include "runtime/evaluate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "compiler/print.hpp"
+#include "grammar/diagnostic_catalogue.hpp"
+
+namespace sidc {
+namespace {
+
+using ir::FactorKind;
+
+int order_of(const ir::Sum& s);
+int order_of(const ir::Factor& f) {
+  switch (f.kind) {
+    case FactorKind::signal:
+    case FactorKind::initial_value: return f.order;
+    case FactorKind::derivative: return f.order + order_of(*f.argument);
+    case FactorKind::function:
+    case FactorKind::power:
+    case FactorKind::integral: return order_of(*f.argument);
+    case FactorKind::guard: {
+      int k = 0;
+      for (const auto& c : f.conditions) k = std::max({k, order_of(*c.lhs), order_of(*c.rhs)});
+      return k;
+    }
+    default: return 0;
+  }
+}
+int order_of(const ir::Sum& s) {
+  int k = 0;
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) k = std::max(k, order_of(f));
+  return k;
+}
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+std::size_t index_at_or_after(const std::vector<double>& time, double t) {
+  const double tolerance = 1e-9 * std::max(1.0, std::abs(t));
+  return static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), t - tolerance) - time.begin());
+}
+
+}  // namespace
+
+int highest_derivative_order(const ir::Model& model) {
+  int k = 0;
+  for (const auto& e : model.equations) {
+    k = std::max(k, order_of(e.known));
+    for (const auto& p : e.terms) k = std::max(k, order_of(p.operation));
+  }
+  return k;
+}
+
+std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, const ir::Model& model,
+                                               const EvaluationOptions& options, std::optional<double> from,
+                                               std::optional<double> to) {
+  const std::size_t n = record.time.size();
+  const int order = highest_derivative_order(model);
+  const std::size_t margin = order > 0 ? static_cast<std::size_t>(samples_lost_each_side(order, options.derivative)) : 0;
+  FitWindow w;
+  w.first = margin;
+  w.last = n > margin ? n - 1 - margin : 0;
+  if (from) w.first = std::max(w.first, index_at_or_after(record.time, *from));
+  if (to) {  // the last sample at or before `to` (0.82 itself when it is a sample)
+    const double tolerance = 1e-9 * std::max(1.0, std::abs(*to));
+    const auto past = static_cast<std::size_t>(std::upper_bound(record.time.begin(), record.time.end(), *to + tolerance) - record.time.begin());
+    if (past == 0) w.last = 0, w.first = 1;
+    else w.last = std::min(w.last, past - 1);
+  }
+  if (n <= 2 * margin || w.first > w.last) {
+    Diagnostic d;
+    d.code = "empty-fit-window";
+    d.message = fmt::format("no samples of `{}` are left in the fit window", record.path);
+    d.hint = fmt::format("the record has {} samples; derivatives of order {} lose {} at each edge{}", n, order, margin,
+                         from || to ? ", and `from`/`to` cut it further" : "");
+    return d;
+  }
+  return w;
+}
+
+Evaluator::Evaluator(const SampledRecord& record, const ir::Model& model, const EvaluationOptions& options, FitWindow window)
+    : record_(record), model_(model), options_(options), window_(window) {}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::string& name, int order, const Span& where) {
+  const auto key = std::pair{name, order};
+  if (auto it = derivatives_.find(key); it != derivatives_.end()) return it->second;
+  const auto found = record_.signals.find(name);
+  if (found == record_.signals.end()) {
+    Diagnostic d;
+    d.code = "signal-not-in-record";
+    d.span = where;
+    d.message = fmt::format("signal `{}` has no values in `{}`", name, record_.path);
+    d.hint = "bind it to a column in the data statement, e.g. `data \"record.csv\" (" + name + " = \"column\")`";
+    return d;
+  }
+  if (order == 0) return derivatives_[key] = found->second;
+  auto estimate = estimate_derivative(found->second, record_.step, order, options_.derivative);
+  if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
+  return derivatives_[key] = std::get<Values>(std::move(estimate));
+}
+
+std::variant<double, Diagnostic> Evaluator::initial_value(const ir::Factor& f, const Span& where) {
+  const auto& time = record_.time;
+  std::size_t index = window_.first;
+  const std::string text = print(f);
+  if (f.at) {
+    const double t = f.at->value();
+    if (t < time.front() - 1e-9 || t > time.back() + 1e-9)
+      return diag::initial_value_outside_record(where, text, t, time.front(), time.back());
+    index = std::min(index_at_or_after(time, t), time.size() - 1);
+    auto values = signal(f.name, f.order, where);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const auto& v = std::get<Values>(values);
+    // Between two samples: linear interpolation.
+    if (index > 0 && std::abs(time[index] - t) > 1e-9 * std::max(1.0, std::abs(t))) {
+      const double a = (t - time[index - 1]) / (time[index] - time[index - 1]);
+      const double value = (1 - a) * v[index - 1] + a * v[index];
+      if (!std::isfinite(value)) return diag::initial_value_unavailable(where, text, t, record_.path);
+      return value;
+    }
+    if (!std::isfinite(v[index])) return diag::initial_value_unavailable(where, text, t, record_.path);
+    return v[index];
+  }
+  auto values = signal(f.name, f.order, where);
+  if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+  const double value = std::get<Values>(values)[index];
+  if (!std::isfinite(value)) return diag::initial_value_unavailable(where, text, time[index], record_.path);
+  return value;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor& f, const Span& where) {
+  const std::size_t n = record_.time.size();
+  switch (f.kind) {
+    case FactorKind::signal: return signal(f.name, f.order, where);
+    case FactorKind::time: return record_.time;
+    case FactorKind::elapsed: {
+      Values v(n);
+      const double t0 = record_.time[window_.first];
+      for (std::size_t i = 0; i < n; ++i) v[i] = record_.time[i] - t0;
+      return v;
+    }
+    case FactorKind::window_start: return Values(n, record_.time[window_.first]);
+    case FactorKind::initial_value: {
+      auto value = initial_value(f, where);
+      if (auto* d = std::get_if<Diagnostic>(&value)) return *d;
+      return Values(n, std::get<double>(value));
+    }
+    case FactorKind::function: {
+      auto argument = evaluate(*f.argument);
+      if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
+      Values v = std::get<Values>(std::move(argument));
+      const std::string& name = f.name;
+      for (double& x : v) {
+        x = name == "sin" ? std::sin(x) : name == "cos" ? std::cos(x) : name == "exp" ? std::exp(x)
+          : name == "log" ? std::log(x) : name == "sqrt" ? std::sqrt(x) : name == "abs" ? std::abs(x)
+          : name == "tanh" ? std::tanh(x) : (std::isnan(x) ? x : static_cast<double>((x > 0) - (x < 0)));
+      }
+      return v;
+    }
+    case FactorKind::power: {
+      auto argument = evaluate(*f.argument);
+      if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
+      Values v = std::get<Values>(std::move(argument));
+      const double e = f.exponent.value();
+      for (double& x : v) x = std::pow(x, e);
+      return v;
+    }
+    case FactorKind::derivative:
+    case FactorKind::integral: {
+      const std::string key = print(f);
+      if (auto it = composite_.find(key); it != composite_.end()) return it->second;
+      auto argument = evaluate(*f.argument);
+      if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
+      const Values& a = std::get<Values>(argument);
+      Values v(n, nan);
+      if (f.kind == FactorKind::derivative) {
+        auto estimate = estimate_derivative(a, record_.step, f.order, options_.derivative);
+        if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
+        v = std::get<Values>(std::move(estimate));
+      } else {
+        // eq. 2-1.4: from t0 (the window's first sample) to t; Simpson's rule (section 3-2).
+        const std::span<const double> slice(a.data() + window_.first, window_.size());
+        auto integral = cumulative_integral(slice, record_.step, options_.integration);
+        if (auto* d = std::get_if<Diagnostic>(&integral)) return *d;
+        const Values& c = std::get<Values>(integral);
+        std::copy(c.begin(), c.end(), v.begin() + static_cast<std::ptrdiff_t>(window_.first));
+      }
+      return composite_[key] = std::move(v);
+    }
+    case FactorKind::guard: {
+      Values v(n, 1.0);
+      for (const auto& c : f.conditions) {
+        auto lhs = evaluate(*c.lhs);
+        if (auto* d = std::get_if<Diagnostic>(&lhs)) return *d;
+        auto rhs = evaluate(*c.rhs);
+        if (auto* d = std::get_if<Diagnostic>(&rhs)) return *d;
+        const Values& l = std::get<Values>(lhs);
+        const Values& r = std::get<Values>(rhs);
+        for (std::size_t i = 0; i < n; ++i) {
+          if (std::isnan(l[i]) || std::isnan(r[i])) {
+            v[i] = nan;
+            continue;
+          }
+          const bool holds = c.relation == ir::Relation::less ? l[i] < r[i]
+                           : c.relation == ir::Relation::less_equal ? l[i] <= r[i]
+                           : c.relation == ir::Relation::greater ? l[i] > r[i] : l[i] >= r[i];
+          if (!holds) v[i] = 0.0;
+        }
+      }
+      return v;
+    }
+    case FactorKind::parameter: break;
+  }
+  Diagnostic d;
+  d.code = "internal";
+  d.message = "a parameter reached the evaluator";
+  return d;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t) {
+  const std::size_t n = record_.time.size();
+  Values v(n, t.coefficient.value());
+  for (const auto& [f, power] : t.factors) {
+    auto values = factor(f, t.span);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& x = std::get<Values>(values);
+    if (f.kind == FactorKind::guard) {
+      // 0 * NaN would be NaN: a guard that is off zeroes the term even where the rest has no value
+      // (a derivative at the very edge), as eq. 4-1.9 defines the regions.
+      for (std::size_t i = 0; i < n; ++i) v[i] = x[i] == 0.0 ? 0.0 : v[i] * x[i];
+      continue;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      double p = x[i];
+      if (power == 2) p = p * p;
+      else if (power != 1) p = std::pow(p, power);
+      if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;
+    }
+  }
+  return v;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate(const ir::Sum& s) {
+  Values total(record_.time.size(), 0.0);
+  for (const auto& t : s.terms) {
+    auto values = term(t);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& v = std::get<Values>(values);
+    for (std::size_t i = 0; i < total.size(); ++i) total[i] += v[i];
+  }
+  return total;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate_in_window(const ir::Sum& s, const std::string& what) {
+  // Term by term, so that a value that is not finite is blamed on the term that made it.
+  Values total(window_.size(), 0.0);
+  for (const auto& t : s.terms) {
+    auto values = term(t);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& v = std::get<Values>(values);
+    for (std::size_t i = 0; i < window_.size(); ++i) {
+      const double x = v[window_.first + i];
+      if (!std::isfinite(x)) {
+        const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
+        return diag::operation_not_finite(t.span, what.empty() ? print(single) : what + ": " + print(single),
+                                          record_.time[window_.first + i], record_.path);
+      }
+      total[i] += x;
+    }
+  }
+  return total;
+}
+
+}  // namespace sidc

@@ -126,9 +126,11 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
     ordered_json parameters = ordered_json::array();
     for (const auto& p : ls.parameters)
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}}});
+    ordered_json regions = ordered_json::array();
+    for (const auto& r : g.regions) regions.push_back({{"guards", r.guards}, {"rows", r.rows}});
     ordered_json dependent = ordered_json::array();
     for (const auto& d : ls.dependent_groups) dependent.push_back(d);
-    groups.push_back({{"equations", equations}, {"records", records}, {"parameters", parameters},
+    groups.push_back({{"equations", equations}, {"records", records}, {"regions", regions}, {"parameters", parameters},
                       {"statistics", {{"n", ls.n}, {"p", ls.p}, {"rank", ls.rank}, {"G", ls.G}, {"standard_error", ls.standard_error},
                                       {"residual_sd", ls.residual_sd}, {"r_squared", ls.r_squared}, {"aic", ls.aic}, {"bic", ls.bic},
                                       {"condition_before_scaling", ls.condition_before}, {"condition_after_scaling", ls.condition_after},

@@ -11,6 +11,49 @@
 
 namespace sidc {
 
+namespace {
+
+void collect_guards(const ir::Sum& s, std::map<std::string, ir::Factor>& guards) {
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) {
+      if (f.kind == ir::FactorKind::guard) guards.emplace(print(f), f);
+      if (f.argument) collect_guards(*f.argument, guards);
+    }
+}
+
+// Counts the rows of each record's window by which of the group's guards hold there.
+std::variant<std::vector<Region>, Diagnostic> count_regions(const ir::Model& model, const std::vector<std::size_t>& equations,
+                                                           std::vector<Evaluator>& evaluators) {
+  std::map<std::string, ir::Factor> guards;
+  for (std::size_t e : equations) {
+    collect_guards(model.equations[e].known, guards);
+    for (const auto& p : model.equations[e].terms) collect_guards(p.operation, guards);
+  }
+  std::vector<Region> regions;
+  if (guards.empty()) return regions;
+  std::map<std::string, std::size_t> counts;
+  for (auto& evaluator : evaluators) {
+    std::vector<std::vector<double>> values;
+    for (const auto& [text, f] : guards) {
+      auto v = evaluator.evaluate_in_window(ir::factor(f), "guard " + text);
+      if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
+      values.push_back(std::get<std::vector<double>>(std::move(v)));
+    }
+    for (std::size_t i = 0; i < evaluator.window().size(); ++i) {
+      std::string key;
+      std::size_t g = 0;
+      for (const auto& [text, f] : guards) {
+        if (values[g++][i] != 0.0) key += (key.empty() ? "" : " and ") + text;
+      }
+      ++counts[key.empty() ? "(no guard)" : key];
+    }
+  }
+  for (auto& [key, n] : counts) regions.push_back({key, n});
+  return regions;
+}
+
+}  // namespace
+
 bool FitOptions::is_valid(std::string* why) const {
   if (from && to && *from > *to) {
     if (why) *why = fmt::format("the fit window starts at {} after it ends at {}", *from, *to);
@@ -108,6 +151,9 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
         row += k.size();
       }
     }
+    auto regions = count_regions(model, members, evaluators);
+    if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
+    g.regions = std::get<std::vector<Region>>(std::move(regions));
     if (total_rows < g.columns.size())
       return diag::window_too_short(records.front().path, total_rows, g.columns.size(),
                                     samples_lost_each_side(std::max(1, highest_derivative_order(model)), options.evaluation.derivative));
@@ -142,6 +188,10 @@ std::string FitSummary::full_report(const ir::Model& model) const {
     }
     for (const auto& r : g.records)
       out += fmt::format("  record {}: t0 = {:g} to {:g}, step {:g}, n = {} per equation\n", r.path, r.t0, r.t_last, r.step, r.rows);
+    if (!g.regions.empty()) {
+      out += "  rows by region (Table 4-1.1):\n";
+      for (const auto& r : g.regions) out += fmt::format("    {:>6}  {}\n", r.rows, r.guards);
+    }
     out += fmt::format("  {:<14} {:>15} {:>13}   {:>31}\n", "parameter", "estimate", "std. error",
                        fmt::format("{:g}% confidence interval", 100 * 0.95));
     for (const auto& p : s.parameters)

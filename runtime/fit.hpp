@@ -34,10 +34,18 @@ struct RecordRows {
   std::size_t first_sample = 0, rows = 0;  // rows per equation
 };
 
+// Rows of the fit by the combination of guards that hold on them (the thesis' quadrants of the
+// phase plane, Table 4-1.1, for eq. 4-1.8's four regions).
+struct Region {
+  std::string guards;  // e.g. "[y <= 0] and [y' >= 0]"; "(no guard)" when none holds
+  std::size_t rows = 0;
+};
+
 struct GroupFit {
   std::vector<std::size_t> equations;          // indices into the model's equations
   std::vector<std::string> columns;            // parameter names, integration constants per record
   std::vector<RecordRows> records;
+  std::vector<Region> regions;  // empty when the equations have no guard
   LeastSquaresSummary summary;
   // Per row of the design: which equation and record, and at what time (for residual files).
   std::vector<std::size_t> row_equation, row_record;

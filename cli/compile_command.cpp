@@ -113,7 +113,15 @@ int run_compile(const CompileArguments& a) {
   std::cout << summary(*r.integrated, a.model) << print(*r.integrated);
   std::string output = a.output;
   if (output.empty()) output = std::filesystem::path(a.model).replace_extension(".sidc.json").string();
-  const std::string json = to_json(CompiledModel{source, *r.normalized, *r.integrated}).dump(1) + "\n";
+  // A data path is relative to the model file; the compiled model may be written elsewhere
+  // (`-o`), and `sidc fit` reads paths relative to it: rebase them.
+  ir::Model written = *r.integrated;
+  const auto model_dir = std::filesystem::absolute(a.model).parent_path();
+  const auto output_dir = std::filesystem::absolute(output).parent_path();
+  for (auto& d : written.data)
+    if (std::filesystem::path(d.path).is_relative())
+      d.path = (model_dir / d.path).lexically_normal().lexically_relative(output_dir).string();
+  const std::string json = to_json(CompiledModel{source, *r.normalized, written}).dump(1) + "\n";
   if (!write_file_atomically(output, json, error)) {
     std::cerr << error << "\nhint: choose a writable place with `-o FILE`\n";
     return exit_code::user_error;

@@ -1,5 +1,7 @@
 #include "cli/fit_command.hpp"
 
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
@@ -155,22 +157,16 @@ std::string residuals_csv(const FitSummary& s) {
   return out;
 }
 
-int run_fit(const FitArguments& a) {
+// One model's fit, reported on stdout; its totals for a comparison table when asked.
+struct ModelTotals {
+  std::string name;
+  std::size_t n = 0, p = 0;
+  double G = 0;
+  bool usable = false;
+};
+
+int fit_one(const std::string& compiled_path, const FitArguments& a, const std::string& out_dir, ModelTotals* totals) {
   std::string error;
-  std::vector<std::string> compiled_paths = a.compiled;
-  if (compiled_paths.empty()) {
-    auto found = default_compiled_model(error);
-    if (!found) {
-      std::cerr << error << "\n";
-      return exit_code::user_error;
-    }
-    compiled_paths.push_back(*found);
-  }
-  if (compiled_paths.size() > 1) {
-    std::cerr << "error: comparing several models is not available yet; fit them one at a time\n";
-    return exit_code::usage_error;
-  }
-  const std::string& compiled_path = compiled_paths.front();
   auto compiled = load_compiled(compiled_path, error);
   if (!compiled) {
     std::cerr << error << "\n";
@@ -229,15 +225,20 @@ int run_fit(const FitArguments& a) {
   }
   const FitSummary& summary = std::get<FitSummary>(result);
   std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << summary.full_report(model);
+  if (totals) {
+    totals->name = model.name.empty() ? compiled_path : model.name;
+    totals->usable = summary.is_solution_usable();
+    for (const auto& g : summary.groups) totals->n += g.summary.n, totals->p += g.summary.p, totals->G += g.summary.G;
+  }
 
-  if (!a.out.empty()) {
+  if (!out_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(a.out, ec);
-    const std::string json_path = (fs::path(a.out) / "fit.json").string();
-    const std::string csv_path = (fs::path(a.out) / "residuals.csv").string();
+    fs::create_directories(out_dir, ec);
+    const std::string json_path = (fs::path(out_dir) / "fit.json").string();
+    const std::string csv_path = (fs::path(out_dir) / "residuals.csv").string();
     if (ec || !write_file_atomically(json_path, fit_json(summary, *compiled, compiled_path, *options).dump(1) + "\n", error) ||
         !write_file_atomically(csv_path, residuals_csv(summary), error)) {
-      std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", a.out, ec.message()) : error) << "\n";
+      std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", out_dir, ec.message()) : error) << "\n";
       return exit_code::user_error;
     }
     std::cerr << "wrote " << json_path << " and " << csv_path << "\n";
@@ -248,6 +249,62 @@ int run_fit(const FitArguments& a) {
     return exit_code::user_error;
   }
   return exit_code::success;
+}
+
+// Section 2-1: "if the system equation has several alternate forms, that form which possesses a
+// minimum sum of the squares of the residuals will constitute the solution of best fit". G(a)
+// only compares forms with the same rows; AIC and BIC also weigh the number of parameters.
+std::string comparison_table(const std::vector<ModelTotals>& models) {
+  std::string out = "\nmodel comparison (thesis Table 4-1.2; smaller is better in the last four columns):\n";
+  out += fmt::format("  {:<28} {:>6} {:>4} {:>14} {:>12} {:>11} {:>11}\n", "model", "n", "p", "G(a)", "sqrt(G/n)", "AIC", "BIC");
+  const bool same_rows = std::all_of(models.begin(), models.end(), [&](const ModelTotals& m) { return m.n == models.front().n; });
+  double best_g = INFINITY, best_aic = INFINITY, best_bic = INFINITY;
+  std::vector<std::array<double, 2>> criteria;
+  for (const auto& m : models) {
+    const double n = static_cast<double>(m.n), k = static_cast<double>(m.p);
+    const double aic = n * std::log(m.G / n) + 2 * k, bic = n * std::log(m.G / n) + k * std::log(n);
+    criteria.push_back({aic, bic});
+    if (m.usable) best_g = std::min(best_g, m.G), best_aic = std::min(best_aic, aic), best_bic = std::min(best_bic, bic);
+  }
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const auto& m = models[i];
+    std::string marks;
+    if (m.usable && same_rows && m.G == best_g) marks += " least G";
+    if (m.usable && criteria[i][0] == best_aic) marks += " best AIC";
+    if (m.usable && criteria[i][1] == best_bic) marks += " best BIC";
+    if (!m.usable) marks = " (rank deficient)";
+    out += fmt::format("  {:<28} {:>6} {:>4} {:>14.6g} {:>12.4g} {:>11.4g} {:>11.4g}{}\n", m.name, m.n, m.p, m.G,
+                       std::sqrt(m.G / static_cast<double>(m.n)), criteria[i][0], criteria[i][1], marks);
+  }
+  if (!same_rows) out += "  (the models were fitted to different numbers of rows, so G(a) does not rank them; AIC and BIC do)\n";
+  return out;
+}
+
+int run_fit(const FitArguments& a) {
+  std::string error;
+  std::vector<std::string> compiled_paths = a.compiled;
+  if (compiled_paths.empty()) {
+    auto found = default_compiled_model(error);
+    if (!found) {
+      std::cerr << error << "\n";
+      return exit_code::user_error;
+    }
+    compiled_paths.push_back(*found);
+  }
+  if (compiled_paths.size() == 1) return fit_one(compiled_paths.front(), a, a.out, nullptr);
+  std::vector<ModelTotals> totals;
+  int status = exit_code::success;
+  for (const auto& path : compiled_paths) {
+    ModelTotals t;
+    const std::string out = a.out.empty() ? "" : (fs::path(a.out) / fs::path(path).stem().stem()).string();
+    const int code = fit_one(path, a, out, &t);
+    if (code != exit_code::success && t.n == 0) return code;  // could not be fitted at all
+    totals.push_back(t);
+    std::cout << "\n";
+    status = std::max(status, code == exit_code::user_error && t.n > 0 ? exit_code::success : code);
+  }
+  std::cout << comparison_table(totals);
+  return status;
 }
 
 }  // namespace

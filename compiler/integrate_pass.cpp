@@ -140,6 +140,13 @@ std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remain
     take(remaining, t);
     return ir::canonical(std::vector<Term>{ir::canonical(p)});
   }
+  // int(der(u, k)) = der(u, k-1), and int(der(u, 1)) = u: by definition, whatever u holds.
+  if (rest.factors.size() == 1 && rest.factors[0].first.kind == FactorKind::derivative && rest.factors[0].second == 1) {
+    const Factor& d = rest.factors[0].first;
+    Sum lower = d.order > 1 ? ir::factor(Factor{FactorKind::derivative, "", d.order - 1, {}, {}, d.argument, {}}) : *d.argument;
+    take(remaining, t);
+    return ir::multiply(ir::canonical(std::vector<Term>{constant}), lower);
+  }
   for (std::size_t i = 0; i < t.factors.size(); ++i) {
     const auto& [f, power] = t.factors[i];
     if (f.kind != FactorKind::signal || f.order < 1 || power < 1) continue;
@@ -208,9 +215,6 @@ struct Integrator {
         current = trial.once(current, index);
         if (const int b = derivative_burden(current); b < best) best = b, times = n;
       }
-    } else if (times > kMaxIntegrations) {
-      diagnostics.add(diag::too_many_integrations(r.span.known() ? r.span : e.span, times, kMaxIntegrations));
-      return e;
     }
     if (times > 0 && !dynamic) {
       diagnostics.add(diag::static_model_integrated(e.span, times));
@@ -231,6 +235,15 @@ int derivative_burden(const ir::Equation& e) {
   int b = burden(e.known);
   for (const auto& p : e.terms) b = std::max(b, burden(p.operation));
   return b;
+}
+
+bool is_static(const ir::Model& model) {
+  for (const auto& e : model.equations) {
+    if (is_dynamic(e.known)) return false;
+    for (const auto& p : e.terms)
+      if (is_dynamic(p.operation)) return false;
+  }
+  return true;
 }
 
 Sum antiderivative(const Sum& s, bool initial) {

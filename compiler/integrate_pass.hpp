@@ -5,7 +5,8 @@
 // `--integrate` option, or `auto` (the smallest N leaving the fewest derivatives to estimate).
 // Each integration replaces a term by an exact antiderivative when one is found and checked (its
 // symbolic derivative must give back exactly the terms it replaces: y'' -> y', y^2*y' -> y^3/3
-// (eq. 2-2.7), y'*y'' -> y'^2/2, x'*y + x*y' -> x*y, constants -> tau), and otherwise by a
+// (eq. 2-2.7), y'*y'' -> y'^2/2, x'*y + x*y' -> x*y, constants -> tau, der(u, k) -> der(u, k-1)),
+// and otherwise by a
 // numerical integral `int(...)`, nested on repeated integration (eq. 2-2.5). Guarded terms are
 // never integrated symbolically. Integration constants become new parameters C1, C2, ... on
 // tau^(N-1)/(N-1)!, ..., tau, 1 (eqs. 2-1.5, 2-2.4, 2-2.5), or, with `constants = initial`, each
@@ -33,5 +34,9 @@ ir::Sum antiderivative(const ir::Sum& s, bool initial);
 
 // The highest derivative order anywhere in the equation, inside integrals and functions too.
 int derivative_burden(const ir::Equation& e);
+
+// True when no equation has a derivative, an integral or the time in it: a static regression such
+// as NIST's `y = b0 + b1*x`, whose records need no time column.
+bool is_static(const ir::Model& model);
 
 }  // namespace sidc

@@ -150,7 +150,7 @@ struct Settings {
     std::string text;
     Span span;
   };
-  std::map<std::string, Value> values;  // key -> raw value, as checked by check_pass
+  std::map<std::string, Value> values;  // key -> raw value, as checked by declare_pass
 };
 
 struct DataSource {

@@ -5,7 +5,7 @@
 // unrolled, constants substituted, `der(...)` differentiated symbolically where it can be (else
 // kept as a derivative factor for the runtime), and `int(...)` split term by term with constant
 // factors and parameters taken outside. Parameters appear only as plain factors; a parameter
-// inside a function, a guard, a denominator, an exponent or an initial value is reported here
+// inside a function, a guard, a denominator or an exponent is reported here
 // (products and powers of parameters by normalize_pass). Without a `param` declaration every
 // free name becomes a parameter, in order of appearance. Pinned by tests/golden/normalized/ and
 // tests/golden/bad/.

@@ -6,7 +6,7 @@
 // factors folded in (eq. 2-1.2); parameter-free terms make up the known side. If the equation had
 // all its parameters on the right-hand side, the sides are exchanged so that signs stay as written.
 // It reports an equation with no parameter, an equation with no known term (its least-squares
-// solution would be all zeros), and two parameters on the same operation (they are dependent).
+// solution would be all zeros), and two parameters on the same or proportional operations (they are dependent).
 // Pinned by tests/golden/normalized/ and tests/golden/bad/.
 #pragma once
 

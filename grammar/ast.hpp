@@ -1,9 +1,9 @@
 // The abstract syntax tree of a `.sid` model file, exactly as written.
 //
 // The tree keeps the user's structure (precedence levels as nested Expressions, as in Spirit X3's
-// calc examples) and every node's position (x3::position_tagged; grammar/annotation.hpp turns
-// positions into Spans). It makes no judgement of meaning: whether `c[k]` names a parameter or
-// `y(0)` an initial value is decided by compiler/check_pass.cpp. docs/language.md is the
+// calc examples) and every node's position (x3::position_tagged; the error handler records
+// each node's byte range, and ParseResult::span turns it into a Span). It makes no judgement of meaning: whether `c[k]` names a parameter or
+// `y(0)` an initial value is decided by compiler/declare_pass.cpp and compiler/lower_pass.cpp. docs/language.md is the
 // specification, with the EBNF this tree follows.
 #pragma once
 

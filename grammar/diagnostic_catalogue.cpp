@@ -74,8 +74,7 @@ std::string syntax_hint(std::string_view what) {
   if (what == e::end_of_statement)
     return "write one statement per line or separate statements with `;`; between two operands write an "
            "operator such as `*`";
-  if (what == e::expression || what == e::operand || what == e::factor)
-    return fmt::format("{}; {}", operand_hint, continuation_hint);
+  if (what == e::expression || what == e::operand || what == e::factor) return operand_hint;
   if (what == e::equation_equals) return "an equation is written `left side = right side`, e.g. `a1*y'' + a2*y = x`";
   if (what == e::closing_parenthesis) return fmt::format("every `(` needs its `)`; {}", continuation_hint);
   if (what == e::closing_bracket) return fmt::format("every `[` needs its `]`; {}", continuation_hint);
@@ -368,11 +367,6 @@ Diagnostic static_model_integrated(const Span& where, int times) {
                "integration rewrites differential equations (thesis section 2-2); use `--integrate 0` for a static model");
 }
 
-Diagnostic too_many_integrations(const Span& where, int times, int limit) {
-  return error("too-many-integrations", where, fmt::format("{} integrations requested; at most {} are supported", times, limit),
-               "the thesis integrates as many times as the highest derivative (eq. 2-2.5); try `auto`");
-}
-
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes) {
   std::string hint = did_you_mean(nearest);
   return error("unknown-pass", {}, fmt::format("unknown pass `{}`", name),
@@ -401,6 +395,11 @@ Diagnostic initial_value_unavailable(const Span& where, std::string_view value, 
 Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last) {
   return error("initial-value-outside-record", where, fmt::format("`{}` asks for t = {}, outside the record ({} to {})", value, time, first, last),
                "give a time within the record");
+}
+
+Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record) {
+  return error("signal-not-in-record", where, fmt::format("signal `{}` has no values in `{}`", signal, record),
+               fmt::format("bind it to a column in the data statement, e.g. `data \"{}\" ({} = \"column\")`", record, signal));
 }
 
 Diagnostic no_data_file(const Span& where) {

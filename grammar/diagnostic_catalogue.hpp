@@ -1,6 +1,6 @@
 // Every message sidc prints about model text, one named constructor each (stanc3's
 // Semantic_error.ml). Passes never format wording themselves; each constructor has a bad-input
-// golden test in tests/golden/bad/. Codes are stable: tests and the JSON output use them.
+// golden test in tests/golden/bad/. Codes are stable: tests rely on them.
 #pragma once
 
 #include <string>
@@ -81,7 +81,7 @@ Diagnostic statement_not_read(const Span& where, std::string_view reason);
 Diagnostic empty_model(const Span& where);
 // [end of grammar-owned section]
 
-// ---- meaning (compiler/check_pass.cpp) ---------------------------------------------------------
+// ---- meaning (compiler/declare_pass.cpp, lower_pass.cpp, normalize_pass.cpp, integrate_pass.cpp) ---------------------------------------------------------
 // [compiler-owned section]
 Diagnostic unknown_name(const Span& where, std::string_view name, std::string_view nearest, bool parameters_declared);
 Diagnostic unknown_function(const Span& where, std::string_view name, std::string_view nearest);
@@ -118,7 +118,6 @@ Diagnostic binding_unknown_signal(const Span& where, std::string_view name, std:
 Diagnostic binding_repeated(const Span& where, std::string_view name);
 Diagnostic binding_of_defined_input(const Span& where, std::string_view name);
 Diagnostic static_model_integrated(const Span& where, int times);
-Diagnostic too_many_integrations(const Span& where, int times, int limit);
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes);
 Diagnostic integrate_option_invalid(std::string_view value);
 Diagnostic no_signal(const Span& where);
@@ -127,6 +126,7 @@ Diagnostic operation_not_finite(const Span& where, std::string_view operation, d
 Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);
 Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last);
 Diagnostic no_data_file(const Span& where);
+Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record);
 Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin);
 // [end of compiler-owned section]
 

@@ -44,7 +44,8 @@ bool is_reserved(std::string_view word) {
 // The characters the grammar can use outside comments and strings.
 bool in_language(unsigned char c) {
   if (c >= 0x80) return false;
-  return is_name_char(static_cast<char>(c)) || std::string_view(" \t\n\r+-*/^()[],=<>'\"#;.").find(static_cast<char>(c)) != std::string_view::npos;
+  constexpr std::string_view punctuation = " \t\n\r+-*/^()[],=<>'\"#;.";
+  return is_name_char(static_cast<char>(c)) || punctuation.find(static_cast<char>(c)) != std::string_view::npos;
 }
 
 // Expectations of a name (or of something that may start with one): a reserved word found there

@@ -3,7 +3,7 @@
 // Relies on nothing but the text. Guarantees: it never throws, crashes or hangs on any input
 // (empty files, binary bytes, 10^6 nested parentheses, a 10 MB line); every problem becomes a
 // Diagnostic with a span; it reports several syntax errors per run by resynchronising at the
-// next statement. Nothing here knows what a signal or a parameter is (compiler/check_pass.cpp).
+// next statement. Nothing here knows what a signal or a parameter is (compiler/declare_pass.cpp, compiler/lower_pass.cpp).
 #pragma once
 
 #include <memory>

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "compiler/integrate_pass.hpp"
+
 namespace sidc {
 namespace {
 
@@ -31,7 +33,7 @@ std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const 
   else if (record.column("t")) time_column = "t";
   else if (record.column("time")) time_column = "time";
   std::vector<double> time;
-  if (!time_column.empty() && !options.step) {
+  if (!time_column.empty()) {
     auto column = complete_column(record, time_column);
     if (auto* d = std::get_if<Diagnostic>(&column)) return *d;
     time = *std::get<const std::vector<double>*>(column);
@@ -40,19 +42,13 @@ std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const 
       if (auto* d = std::get_if<Diagnostic>(&step)) return *d;
       out.step = std::get<double>(step);
     }
-  } else if (options.step) {
-    out.step = *options.step;
+  } else if (options.step || is_static(model)) {
+    // A static model's rows are observations, not samples in time: number them 0, 1, 2, ...
+    out.step = options.step.value_or(1.0);
     time.resize(rows);
     for (std::size_t k = 0; k < rows; ++k) time[k] = static_cast<double>(k) * out.step;
   } else {
-    Diagnostic d;
-    d.code = "no-time-column";
-    d.data_file = record.path;
-    d.row = record.header_line > 0 ? record.header_line : 1;
-    d.column = 1;
-    d.message = "the record has no time column (`t` or `time`) and no sampling step was given";
-    d.hint = "bind one in the model (`data \"" + record.path + "\" (t = \"seconds\")`), or give the step with `set step = 0.01` or `--step 0.01`";
-    return d;
+    return data_diag::no_time_column(record.path, record.header_line > 0 ? record.header_line : 1);
   }
 
   // The signals read from columns.

@@ -2,7 +2,7 @@
 //
 // Relies on: runtime/records.hpp (the file as columns) and the compiled model's data statement.
 // Guarantees: the time column (the one bound to `t`, else a column named `t` or `time`, else a
-// given step) is uniformly sampled within tolerance, or the first bad row is named (`--resample`
+// given step; a static model's rows are simply numbered) is uniformly sampled within tolerance, or the first bad row is named (`--resample`
 // interpolates onto a uniform grid instead); every signal without a definition is a complete
 // column; `every` keeps every k-th sample (the thesis' Delta = 0.020 from its Delta = 0.010 record);
 // inputs given as expressions of t are evaluated on the grid.

@@ -48,7 +48,7 @@ Diagnostic cannot_open(std::string_view path, std::string_view reason) {
   Diagnostic d;
   d.code = "data-cannot-open";
   d.message = fmt::format("cannot read data file `{}`: {}", shown_path(path), reason);
-  d.hint = "check the path; it is relative to the current directory";
+  d.hint = "check the path: a path in a model's `data` statement is relative to the model file, one given with `--data` to the current directory";
   return d;
 }
 
@@ -207,6 +207,22 @@ Diagnostic empty_time_window(std::string_view path, std::string_view name, doubl
                  fmt::format("no sample of `{}` lies in the window [{}, {}]; the record spans [{}, {}]", shown(name),
                              from, to, first, last),
                  "choose a window inside the record");
+}
+
+Diagnostic no_time_column(std::string_view path, int header_row) {
+  return located("data-no-time-column", path, header_row, 1,
+                 "the record has no time column (`t` or `time`) and no sampling step was given",
+                 fmt::format("bind one in the model (`data \"{}\" (t = \"seconds\")`), or give the step with `set step = 0.01` "
+                             "or `--step 0.01`", path));
+}
+
+Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int order, std::size_t margin, bool cut_by_window) {
+  Diagnostic d;
+  d.code = "data-empty-fit-window";
+  d.message = fmt::format("no samples of `{}` are left in the fit window", path);
+  d.hint = fmt::format("the record has {} samples; derivatives of order {} lose {} at each edge{}", samples, order, margin,
+                       cut_by_window ? ", and `from`/`to` cut it further" : "");
+  return d;
 }
 
 Diagnostic invalid_signal_options(std::string_view operation, std::string_view why) {

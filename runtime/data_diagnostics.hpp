@@ -4,8 +4,8 @@
 // (tests/runtime/bad_records_test.cpp, files in tests/data/bad/) pin every one of them.
 //
 // Locations are `file:row:col` with row = 1-based line number in the file (comments, blank lines
-// and the header count) and col = 1-based field index on that line. Codes are stable: tests and
-// the JSON output use them. A problem with no sensible location (the file cannot be opened)
+// and the header count) and col = 1-based field index on that line. Codes are stable: tests rely
+// on them. A problem with no sensible location (the file cannot be opened)
 // carries no data_file and names the path in its message instead.
 #pragma once
 
@@ -66,6 +66,9 @@ Diagnostic empty_time_window(std::string_view path, std::string_view name, doubl
 // ---- signal operations (savitzky_golay.cpp, simpson.cpp); no location: the caller adds the
 // span of the model term that asked for the operation ---------------------------------------------
 Diagnostic invalid_signal_options(std::string_view operation, std::string_view why);
+// Binding a record to a model (runtime/bind_record.cpp, runtime/evaluate.cpp).
+Diagnostic no_time_column(std::string_view path, int header_row);
+Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int order, std::size_t margin, bool cut_by_window);
 Diagnostic signal_shorter_than_window(std::size_t samples, int window);
 
 }  // namespace sidc::data_diag

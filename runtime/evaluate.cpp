@@ -6,6 +6,8 @@
 
 #include "compiler/print.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
+#include "runtime/data_diagnostics.hpp"
+#include <stdexcept>
 
 namespace sidc {
 namespace {
@@ -71,12 +73,7 @@ std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, cons
     else w.last = std::min(w.last, past - 1);
   }
   if (n <= 2 * margin || w.first > w.last) {
-    Diagnostic d;
-    d.code = "empty-fit-window";
-    d.message = fmt::format("no samples of `{}` are left in the fit window", record.path);
-    d.hint = fmt::format("the record has {} samples; derivatives of order {} lose {} at each edge{}", n, order, margin,
-                         from || to ? ", and `from`/`to` cut it further" : "");
-    return d;
+    return data_diag::empty_fit_window(record.path, n, order, margin, from || to);
   }
   return w;
 }
@@ -89,12 +86,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::strin
   if (auto it = derivatives_.find(key); it != derivatives_.end()) return it->second;
   const auto found = record_.signals.find(name);
   if (found == record_.signals.end()) {
-    Diagnostic d;
-    d.code = "signal-not-in-record";
-    d.span = where;
-    d.message = fmt::format("signal `{}` has no values in `{}`", name, record_.path);
-    d.hint = "bind it to a column in the data statement, e.g. `data \"record.csv\" (" + name + " = \"column\")`";
-    return d;
+    return diag::signal_not_in_record(where, name, record_.path);
   }
   if (order == 0) return derivatives_[key] = found->second;
   auto estimate = estimate_derivative(found->second, record_.step, order, options_.derivative);
@@ -214,10 +206,8 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
     }
     case FactorKind::parameter: break;
   }
-  Diagnostic d;
-  d.code = "internal";
-  d.message = "a parameter reached the evaluator";
-  return d;
+  // normalize_pass takes every parameter out of the operations; one here is a bug (exit code 3).
+  throw std::logic_error("a parameter factor reached the evaluator");
 }
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t) {

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <set>
 
+#include "compiler/integrate_pass.hpp"
 #include "compiler/print.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
 
@@ -92,7 +93,7 @@ std::vector<std::vector<std::size_t>> equation_groups(const ir::Model& model) {
 std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vector<SampledRecord>& records,
                                          const FitOptions& options) {
   FitSummary summary;
-  summary.model = model.name;
+  summary.model_name = model.name;
   std::vector<FitWindow> windows;
   for (const auto& r : records) {
     auto w = fit_window(r, model, options.evaluation, options.from, options.to);
@@ -186,8 +187,12 @@ std::string FitSummary::full_report(const ir::Model& model) const {
                          eq.integrations ? fmt::format(" (integrated {} time{})", eq.integrations, eq.integrations == 1 ? "" : "s") : "",
                          text);
     }
-    for (const auto& r : g.records)
-      out += fmt::format("  record {}: t0 = {:g} to {:g}, step {:g}, n = {} per equation\n", r.path, r.t0, r.t_last, r.step, r.rows);
+    for (const auto& r : g.records) {
+      if (is_static(model))
+        out += fmt::format("  record {}: rows {} to {}, n = {} per equation\n", r.path, r.first_sample + 1, r.first_sample + r.rows, r.rows);
+      else
+        out += fmt::format("  record {}: t0 = {:g} to {:g}, step {:g}, n = {} per equation\n", r.path, r.t0, r.t_last, r.step, r.rows);
+    }
     if (!g.regions.empty()) {
       out += "  rows by region (Table 4-1.1):\n";
       for (const auto& r : g.regions) out += fmt::format("    {:>6}  {}\n", r.rows, r.guards);
@@ -202,6 +207,10 @@ std::string FitSummary::full_report(const ir::Model& model) const {
     out += fmt::format("  condition {:.3g} before scaling, {:.3g} after (section 3-2); about {:.1f} digits lost\n", s.condition_before,
                        s.condition_after, s.digits_lost_estimate);
     out += fmt::format("  arithmetic: {}\n", s.arithmetic);
+    // Double precision carries about 16 digits; the scaled condition number says how many survive.
+    if (const double left = 16 - s.digits_lost_estimate; s.is_solution_usable() && left < 4)
+      out += fmt::format("  WARNING: only about {:.0f} correct digit{} can be expected in the estimates (condition {:.3g} after scaling)\n",
+                         std::max(0.0, left), left >= 0.5 && left < 1.5 ? "" : "s", s.condition_after);
     if (!s.is_solution_usable()) out += fmt::format("  NOT USABLE: {}: {}\n", to_string(s.termination), s.message);
     for (const auto& group : s.dependent_groups) {
       std::string names;

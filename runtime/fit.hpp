@@ -54,7 +54,7 @@ struct GroupFit {
 };
 
 struct FitSummary {
-  std::string model;
+  std::string model_name;
   std::vector<GroupFit> groups;
   bool is_solution_usable() const;
   std::string brief_report() const;

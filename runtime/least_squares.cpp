@@ -363,7 +363,7 @@ std::string check_rows(const Rows& rows, const std::vector<std::string>& names) 
     for (Index j = 0; j < p; ++j) {
       for (Index i = 0; i < n; ++i) {
         if (!std::isfinite(rows.A(i, j))) {
-          return fmt::format("column '{}' is {} at {}", names[static_cast<std::size_t>(j)],
+          return fmt::format("column `{}` is {} at {}", names[static_cast<std::size_t>(j)],
                              rows.A(i, j), format_row(static_cast<std::size_t>(i)));
         }
       }
@@ -609,11 +609,11 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
     std::vector<std::string> parts;
     for (const auto& group : summary.dependent_groups) {
       if (group.size() == 1) {
-        parts.push_back(fmt::format("'{}' is zero or negligible", group[0]));
+        parts.push_back(fmt::format("`{}` is zero or negligible", group[0]));
       } else {
         std::string others;
-        for (std::size_t m = 1; m < group.size(); ++m) others += (m > 1 ? ", '" : "'") + group[m] + "'";
-        parts.push_back(fmt::format("'{}' depends on {}", group[0], others));
+        for (std::size_t m = 1; m < group.size(); ++m) others += fmt::format("{}`{}`", m > 1 ? ", " : "", group[m]);
+        parts.push_back(fmt::format("`{}` depends on {}", group[0], others));
       }
     }
     std::string joined;
@@ -716,9 +716,9 @@ std::string LeastSquaresSummary::full_report() const {
   }
   for (const auto& group : dependent_groups) {
     std::string names;
-    for (std::size_t m = 1; m < group.size(); ++m) names += (m > 1 ? ", " : "") + group[m];
-    text += group.size() == 1 ? fmt::format("  dependent: '{}' is zero or negligible\n", group[0])
-                              : fmt::format("  dependent: '{}' ~ combination of {}\n", group[0], names);
+    for (std::size_t m = 1; m < group.size(); ++m) names += fmt::format("{}`{}`", m > 1 ? ", " : "", group[m]);
+    text += group.size() == 1 ? fmt::format("  dependent: `{}` is zero or negligible\n", group[0])
+                              : fmt::format("  dependent: `{}` ~ combination of {}\n", group[0], names);
   }
   return text;
 }

@@ -130,6 +130,130 @@ TEST(Span, StatementsAfterAFailedOneStillHaveTheirSpans) {
   for (const auto& [begin, end] : result.positions) EXPECT_GE(begin, result.source->text.find("w ="));
 }
 
+// Visits every node of a model and checks its span: known, not empty, and covering exactly the
+// text of names, numbers and variables.
+struct SpanChecker {
+  const ParseResult& result;
+  int nodes = 0;
+
+  void check(const x3::position_tagged& node, const char* kind) {
+    ++nodes;
+    const Span where = result.span(node);
+    ASSERT_TRUE(where.known()) << kind;
+    EXPECT_LT(where.begin, where.end) << kind;
+  }
+  void operator()(const ast::Identifier& n) {
+    check(n, "Identifier");
+    EXPECT_EQ(covered(result, result.span(n)), n.name);
+  }
+  void operator()(const ast::Number& n) {
+    check(n, "Number");
+    EXPECT_EQ(covered(result, result.span(n)), n.text);
+  }
+  void operator()(const ast::Variable& n) {
+    check(n, "Variable");
+    EXPECT_EQ(covered(result, result.span(n)), n.name.name + n.primes);
+    (*this)(n.name);
+  }
+  void operator()(const ast::Signed& n) {
+    check(n, "Signed");
+    (*this)(n.operand);
+  }
+  void operator()(const ast::Call& n) {
+    check(n, "Call");
+    (*this)(n.callee);
+    for (const auto& a : n.arguments) (*this)(a);
+  }
+  void operator()(const ast::Indexed& n) {
+    check(n, "Indexed");
+    (*this)(n.name);
+    (*this)(n.index);
+  }
+  void operator()(const ast::Guard& n) {
+    check(n, "Guard");
+    for (const auto& c : n.conditions) {
+      check(c, "Comparison");
+      (*this)(c.lhs);
+      (*this)(c.rhs);
+    }
+  }
+  void operator()(const ast::SumOver& n) {
+    check(n, "SumOver");
+    (*this)(n.index);
+    (*this)(n.body);
+  }
+  void operator()(const ast::Expression& n) {
+    check(n, "Expression");
+    (*this)(n.first);
+    for (const auto& o : n.rest) {
+      check(o, "Operation");
+      (*this)(o.operand);
+    }
+  }
+  void operator()(const ast::Operand& n) { boost::apply_visitor(*this, n.get()); }
+  template <typename T>
+  void operator()(const x3::forward_ast<T>& n) { (*this)(n.get()); }
+
+  void operator()(const ast::ModelName& n) {
+    check(n, "ModelName");
+    (*this)(n.name);
+  }
+  void operator()(const ast::SignalDeclaration& n) {
+    check(n, "SignalDeclaration");
+    for (const auto& item : n.signals) {
+      check(item, "SignalItem");
+      (*this)(item.name);
+      if (item.definition) (*this)(*item.definition);
+    }
+  }
+  void operator()(const ast::ParameterDeclaration& n) {
+    check(n, "ParameterDeclaration");
+    for (const auto& item : n.parameters) {
+      check(item, "ParameterItem");
+      (*this)(item.name);
+    }
+  }
+  void operator()(const ast::ConstantDeclaration& n) {
+    check(n, "ConstantDeclaration");
+    for (const auto& item : n.constants) {
+      check(item, "ConstantItem");
+      (*this)(item.name);
+      (*this)(item.value);
+    }
+  }
+  void operator()(const ast::DataStatement& n) {
+    check(n, "DataStatement");
+    for (const auto& binding : n.bindings) {
+      check(binding, "ColumnBinding");
+      (*this)(binding.signal);
+    }
+  }
+  void operator()(const ast::Setting& n) {
+    check(n, "Setting");
+    (*this)(n.key);
+    EXPECT_EQ(result.source->text.substr(n.value_offset, n.value.size()), n.value);
+  }
+  void operator()(const ast::Equation& n) {
+    check(n, "Equation");
+    (*this)(n.lhs);
+    (*this)(n.rhs);
+  }
+};
+
+TEST(Span, EveryNodeOfEveryKindHasOne) {
+  const ParseResult result = parse_text(
+      "model quasi_linear\n"
+      "input x = 60*sin(4*pi*t), w\noutput y\n"
+      "param m, a[1..24]\nconst g = 9.81, L = -2*g\n"
+      "data \"r.csv\" (t = \"time\", y = disp)\nset integrate = 1 # once\n"
+      "m*y'' + sum(k = 1..6, a[k]*y'^k)*[y' <= 0 and y > -2] +\n"
+      "  der(y^3, 1) + int(y) + y'(0) - (y/g)^-1 = x\n");
+  ASSERT_EQ(result.model.statements.size(), 8u) << result.diagnostics.render_all();
+  SpanChecker checker{result};
+  for (const auto& statement : result.model.statements) boost::apply_visitor(checker, statement.get());
+  EXPECT_GT(checker.nodes, 80);
+}
+
 TEST(Span, NodeThatWasNeverParsedHasAnUnknownSpan) {
   const ParseResult result = parse_text("z = y");
   EXPECT_FALSE(result.span(ast::Variable{}).known());

@@ -166,6 +166,9 @@ struct Table412Row {
   double thesis_delta_0_020;
 };
 
+// Shown by GoogleTest (and in CTest's test name) instead of the struct's bytes.
+void PrintTo(const Table412Row& row, std::ostream* os) { *os << row.model; }
+
 class Table412LowOrderRows : public ThesisSection41, public ::testing::WithParamInterface<Table412Row> {};
 
 TEST_P(Table412LowOrderRows, ResidualWithinOneUnitOfThesis) {

@@ -28,6 +28,7 @@ struct FitArguments {
   std::optional<int> every;
   std::string derivative, second_derivative, edges, integration, precision;
   std::string out;
+  std::string weights;
 };
 
 // The compiled model to fit when none is named: the only *.sidc.json in the current directory.
@@ -48,7 +49,7 @@ std::optional<std::string> default_compiled_model(std::string& error) {
 std::optional<CompiledModel> load_compiled(const std::string& path, std::string& error) {
   auto text = read_whole_file(path, error);
   if (!text) return std::nullopt;
-  const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(*text, nullptr, false);
   if (j.is_discarded()) {
     error = fmt::format("error: `{}` is not JSON; compile the model again with `sidc compile`", path);
     return std::nullopt;
@@ -203,6 +204,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   bind.every = a.every.value_or(e.every);
   bind.step = a.step ? a.step : e.step;
   bind.resample = a.resample;
+  if (!a.weights.empty()) bind.weights = a.weights;
+  else bind.weights = e.weights;
   std::vector<SampledRecord> records;
   for (const auto& s : sources) {
     auto record = read_csv(s.path);
@@ -325,6 +328,7 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_option("--integration", a->integration, "simpson or trapezoid")->check(CLI::IsMember({"simpson", "trapezoid"}));
   cmd->add_option("--precision", a->precision, "Least-squares arithmetic: automatic, double or extended")
       ->check(CLI::IsMember({"automatic", "double", "extended"}));
+  cmd->add_option("--weights", a->weights, "A record column weighting each row's residual (eq. 2-1.6)");
   cmd->add_option("--out", a->out, "Directory for fit.json and residuals.csv");
   cmd->callback([a, &exit_status] { exit_status = run_fit(*a); });
 }

@@ -1,6 +1,7 @@
 #include "compiler/compiled_model.hpp"
 
 #include <fmt/format.h>
+#include <set>
 
 #include "compiler/print.hpp"
 #include "compiler/settings.hpp"
@@ -8,7 +9,7 @@
 namespace sidc {
 namespace {
 
-using nlohmann::json;
+using json = nlohmann::ordered_json;
 using ordered = nlohmann::ordered_json;
 using ir::FactorKind;
 
@@ -110,6 +111,7 @@ ordered settings_json(const ir::Settings& raw) {
   j["to"] = optional_number(e.to);
   j["every"] = e.every;
   j["step"] = optional_number(e.step);
+  j["weights"] = e.weights ? ordered(*e.weights) : ordered(nullptr);
   ordered as_written = ordered::object();
   for (const auto& [key, value] : raw.values) as_written[key] = value.text;
   j["as_written"] = std::move(as_written);
@@ -127,8 +129,17 @@ const char* origin_name(ir::Parameter::Origin o) {
 
 // ---- reading ------------------------------------------------------------------------------------
 
+// One of `allowed`, or an error naming the field.
+std::string one_of(const json& j, const char* field, std::initializer_list<const char*> allowed) {
+  const std::string value = j.at(field).get<std::string>();
+  for (const char* a : allowed)
+    if (value == a) return value;
+  throw std::runtime_error(fmt::format("`{}` is not a valid {}", value, field));
+}
+
 struct Reader {
   std::shared_ptr<const SourceFile> source;
+  std::set<std::string> signals;
 
   Span span(const json& j) const {
     if (j.is_null()) return {};
@@ -146,7 +157,11 @@ struct Reader {
     std::vector<ir::Term> terms;
     for (const auto& t : j.at("terms")) {
       ir::Term term{number(t.at("coefficient")), {}, span(t.at("span"))};
-      for (const auto& f : t.at("factors")) term.factors.push_back({factor(f), f.at("power").get<int>()});
+      for (const auto& f : t.at("factors")) {
+        const int power = f.at("power").get<int>();
+        if (power == 0) throw std::runtime_error("a factor with power 0");
+        term.factors.push_back({factor(f), power});
+      }
       terms.push_back(ir::canonical(std::move(term)));
     }
     return ir::canonical(std::move(terms));
@@ -154,6 +169,9 @@ struct Reader {
   ir::Factor factor(const json& j) const {
     const auto kind = kind_from(j.at("kind").get<std::string>());
     if (!kind) throw std::runtime_error("unknown factor kind `" + j.at("kind").get<std::string>() + "`");
+    if (*kind == FactorKind::parameter) throw std::runtime_error("a parameter factor inside an operation");
+    if ((*kind == FactorKind::signal || *kind == FactorKind::initial_value) && !signals.count(j.at("name").get<std::string>()))
+      throw std::runtime_error("a factor names the undeclared signal `" + j.at("name").get<std::string>() + "`");
     ir::Factor f{*kind, j.value("name", std::string()), j.value("order", 0), {}, {}, {}, {}};
     if (*kind == FactorKind::initial_value && !j.at("at").is_null()) f.at = number(j.at("at"));
     if (j.contains("exponent")) f.exponent = number(j.at("exponent"));
@@ -161,6 +179,7 @@ struct Reader {
     if (*kind == FactorKind::guard)
       for (const auto& c : j.at("conditions")) {
         const std::string r = c.at("relation").get<std::string>();
+        if (r != "<" && r != "<=" && r != ">" && r != ">=") throw std::runtime_error("unknown relation `" + r + "`");
         const ir::Relation rel = r == "<" ? ir::Relation::less : r == "<=" ? ir::Relation::less_equal
                                : r == ">" ? ir::Relation::greater : ir::Relation::greater_equal;
         f.conditions.push_back({sum_ptr(c.at("lhs")), rel, sum_ptr(c.at("rhs"))});
@@ -230,7 +249,7 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
   return j;
 }
 
-std::optional<CompiledModel> compiled_model_from_json(const nlohmann::json& j, const std::string& path, std::string& error) {
+std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_json& j, const std::string& path, std::string& error) {
   try {
     if (j.value("format", std::string()) != "sidc-compiled-model") {
       error = fmt::format("error: `{}` is not a compiled sidc model", path);
@@ -243,20 +262,23 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::json& j, c
     }
     CompiledModel c;
     c.source = std::make_shared<const SourceFile>(j.at("source").at("path").get<std::string>(), j.at("source").at("text").get<std::string>());
-    Reader r{c.source};
+    if (j.at("source").at("hash").get<std::string>() != source_hash(c.source->text))
+      throw std::runtime_error("the source text does not match its hash");
+    Reader r{c.source, {}};
+    for (const auto& s : j.at("signals")) r.signals.insert(s.at("name").get<std::string>());
     ir::Model& m = c.integrated;
     m.name = j.at("model").get<std::string>();
     for (const auto& s : j.at("signals")) {
       ir::Signal sig;
       sig.name = s.at("name").get<std::string>();
-      sig.kind = s.at("kind").get<std::string>() == "input" ? ir::Signal::Kind::input : ir::Signal::Kind::output;
+      sig.kind = one_of(s, "kind", {"input", "output"}) == "input" ? ir::Signal::Kind::input : ir::Signal::Kind::output;
       sig.span = r.span(s.at("span"));
       sig.used = true;
       if (!s.at("definition").is_null()) sig.definition = r.sum(s.at("definition"));
       m.signals.push_back(std::move(sig));
     }
     for (const auto& p : j.at("parameters")) {
-      const std::string origin = p.at("origin").get<std::string>();
+      const std::string origin = one_of(p, "origin", {"declared", "implicit", "integration_constant"});
       m.parameters.push_back({p.at("name").get<std::string>(),
                               origin == "implicit" ? ir::Parameter::Origin::implicit
                               : origin == "integration_constant" ? ir::Parameter::Origin::integration_constant
@@ -264,7 +286,13 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::json& j, c
                               r.span(p.at("span")), p.at("equation").get<int>()});
     }
     for (const auto& [name, value] : j.at("constants").items()) m.constants.emplace(name, r.number(value));
-    for (const auto& [key, value] : j.at("settings").at("as_written").items()) m.settings.values[key] = {value.get<std::string>(), {}};
+    for (const auto& [key, value] : j.at("settings").at("as_written").items()) {
+      const std::string text = value.get<std::string>();
+      const SettingCheck check = check_setting(key, text);
+      if (check.unknown_key) throw std::runtime_error("unknown setting `" + key + "`");
+      if (!check.expected.empty()) throw std::runtime_error(fmt::format("`{}` is not a valid value for setting `{}`", text, key));
+      m.settings.values[key] = {text, {}};
+    }
     for (const auto& d : j.at("data")) {
       ir::DataSource source;
       source.path = d.at("path").get<std::string>();
@@ -275,8 +303,8 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::json& j, c
       ir::Equation eq;
       eq.span = r.span(e.at("span"));
       eq.integrations = e.at("integrations").get<int>();
-      eq.integration.constants = e.at("constants").get<std::string>() == "initial" ? ir::IntegrationRequest::Constants::initial
-                                                                                   : ir::IntegrationRequest::Constants::fitted;
+      eq.integration.constants = one_of(e, "constants", {"fitted", "initial"}) == "initial" ? ir::IntegrationRequest::Constants::initial
+                                                                                             : ir::IntegrationRequest::Constants::fitted;
       for (const auto& o : e.at("operations")) {
         const int index = m.parameter_index(o.at("parameter").get<std::string>());
         if (index < 0) throw std::runtime_error("an operation names an undeclared parameter");

@@ -28,7 +28,7 @@ struct CompiledModel {
 nlohmann::ordered_json to_json(const CompiledModel& compiled);
 
 // Reads a compiled model back; nullopt with `error` naming what is wrong (`path` is for messages).
-std::optional<CompiledModel> compiled_model_from_json(const nlohmann::json& j, const std::string& path, std::string& error);
+std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_json& j, const std::string& path, std::string& error);
 
 // FNV-1a, 64 bits, as 16 hex digits: identifies the source text (not a security hash).
 std::string source_hash(const std::string& text);

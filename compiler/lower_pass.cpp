@@ -482,6 +482,11 @@ struct Lowerer {
     failed = false;
     Sum s = lower(e);
     if (failed) return std::nullopt;
+    for (const auto& t : s.terms)
+      if (!std::isfinite(t.coefficient.value())) {
+        report(diag::not_a_number(t.span.known() ? t.span : span(e), "a coefficient (it overflows to infinity here)"));
+        return std::nullopt;
+      }
     return s;
   }
 };

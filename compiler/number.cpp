@@ -47,7 +47,11 @@ std::optional<Number> Number::parse(std::string_view text) {
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), as_double);
   if (ec != std::errc() || end != text.data() + text.size()) {
     // from_chars does not take a leading '.', which the language allows (`.5`).
-    if (!text.empty() && text[0] == '.') return parse(std::string("0") + std::string(text));
+    if (!text.empty() && text[0] == '.') {
+      std::string with_zero(1, '0');
+      with_zero.append(text);
+      return parse(with_zero);
+    }
     return std::nullopt;
   }
   // Exact reading: digits with an optional point and a decimal exponent.

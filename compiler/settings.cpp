@@ -26,7 +26,7 @@ std::optional<int> whole_number(const std::string& text) {
 
 const std::vector<std::string>& setting_keys() {
   static const std::vector<std::string> keys{"integrate", "constants", "derivative", "second_derivative", "edges",
-                                             "integration", "smooth_before_integration", "from", "to", "every", "step"};
+                                             "integration", "smooth_before_integration", "from", "to", "every", "step", "weights"};
   return keys;
 }
 
@@ -66,6 +66,9 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
   } else if (key == "every") {
     const auto n = whole_number(value);
     if (!n || *n < 1) r.expected = "a whole number of at least 1 (keep every k-th sample)";
+  } else if (key == "weights") {
+    static const std::regex column(R"("[^"]+"|[A-Za-z_][A-Za-z0-9_]*)");
+    if (!std::regex_match(value, column)) r.expected = "the name of a record column holding the weight of each row (eq. 2-1.6), e.g. `w` or `\"weight\"`";
   } else if (key == "step") {
     if (!positive_number(value)) r.expected = "a positive sampling step, e.g. `0.01`";
   } else {
@@ -89,6 +92,7 @@ EvaluationSettings evaluation_settings(const ir::Settings& settings) {
   if (auto v = get("to")) e.to = Number::parse(*v)->value();
   if (auto v = get("every")) e.every = std::stoi(*v);
   if (auto v = get("step")) e.step = Number::parse(*v)->value();
+  if (auto v = get("weights")) e.weights = v->front() == '"' ? v->substr(1, v->size() - 2) : *v;
   return e;
 }
 

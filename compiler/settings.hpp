@@ -36,6 +36,7 @@ struct EvaluationSettings {
   std::optional<double> from, to;          // fit window in time
   int every = 1;                           // decimation
   std::optional<double> step;              // sampling step when the record has no time column
+  std::optional<std::string> weights;      // a record column weighting each row's residual (eq. 2-1.6)
 };
 
 // Typed settings from checked raw values (check_setting has accepted every one).

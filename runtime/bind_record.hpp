@@ -22,6 +22,7 @@ struct BindOptions {
   std::optional<double> step;      // sampling step when the record has no time column
   std::optional<double> resample;  // interpolate linearly onto this step
   int every = 1;                   // decimation
+  std::optional<std::string> weights;  // column of row weights (eq. 2-1.6)
   UniformStepOptions uniform;
 };
 

@@ -29,6 +29,8 @@ struct SampledRecord {
   std::vector<double> time;                            // absolute times, time[k] = time[0] + k*step
   std::map<std::string, std::vector<double>> signals;  // by signal name
   std::map<std::string, std::string> columns;          // signal -> the column it came from (for messages)
+  std::vector<double> weights;                         // eq. 2-1.6: per sample; empty = all 1
+  std::string weights_column;
 };
 
 struct EvaluationOptions {

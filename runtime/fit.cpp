@@ -124,6 +124,8 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     for (std::size_t r = 0; r < records.size(); ++r) total_rows += windows[r].size() * members.size();
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(total_rows), static_cast<Eigen::Index>(g.columns.size()));
     Eigen::VectorXd b(static_cast<Eigen::Index>(total_rows));
+    Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(total_rows));
+    const bool weighted = std::any_of(records.begin(), records.end(), [](const SampledRecord& r) { return !r.weights.empty(); });
     std::size_t row = 0;
     for (std::size_t r = 0; r < records.size(); ++r) {
       const FitWindow& w = windows[r];
@@ -144,6 +146,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
         const auto& k = std::get<std::vector<double>>(known);
         for (std::size_t i = 0; i < k.size(); ++i) {
           b(static_cast<Eigen::Index>(row + i)) = k[i];
+          if (!records[r].weights.empty()) weights(static_cast<Eigen::Index>(row + i)) = records[r].weights[w.first + i];
           g.row_equation.push_back(e);
           g.row_record.push_back(r);
           g.row_time.push_back(records[r].time[w.first + i]);
@@ -158,7 +161,8 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     if (total_rows < g.columns.size())
       return diag::window_too_short(records.front().path, total_rows, g.columns.size(),
                                     samples_lost_each_side(std::max(1, highest_derivative_order(model)), options.evaluation.derivative));
-    g.summary = solve_least_squares(A, b, g.columns, nullptr, options.least_squares);
+    g.weighted = weighted;
+    g.summary = solve_least_squares(A, b, g.columns, weighted ? &weights : nullptr, options.least_squares);
     summary.groups.push_back(std::move(g));
   }
   return summary;
@@ -201,6 +205,7 @@ std::string FitSummary::full_report(const ir::Model& model) const {
                        fmt::format("{:g}% confidence interval", 100 * 0.95));
     for (const auto& p : s.parameters)
       out += fmt::format("  {:<14} {:>15.6g} {:>13.4g}   [{:>13.6g}, {:>13.6g}]\n", p.name, p.value, p.standard_error, p.ci_low, p.ci_high);
+    if (g.weighted) out += "  residuals weighted by the record's weight column (eq. 2-1.6)\n";
     out += fmt::format("  G(a) = {:.6g} (eq. 2-1.7)   standard error sqrt(G/n) = {:.4g}   residual s.d. = {:.4g}\n", s.G,
                        s.standard_error, s.residual_sd);
     out += fmt::format("  n = {}, p = {}, rank {}   R^2 = {:.6f}   AIC = {:.4g}   BIC = {:.4g}\n", s.n, s.p, s.rank, s.r_squared, s.aic, s.bic);

@@ -46,6 +46,7 @@ struct GroupFit {
   std::vector<std::string> columns;            // parameter names, integration constants per record
   std::vector<RecordRows> records;
   std::vector<Region> regions;  // empty when the equations have no guard
+  bool weighted = false;        // rows weighted by a record column (eq. 2-1.6)
   LeastSquaresSummary summary;
   // Per row of the design: which equation and record, and at what time (for residual files).
   std::vector<std::size_t> row_equation, row_record;

@@ -371,7 +371,7 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
 // `>=`, a power 0 drops the factor, an unknown setting value reaches evaluation_settings, which
 // dereferences an empty optional or throws from std::stoi in `sidc fit`). Disabled until
 // compiled_model_from_json checks them; enable it then (reported to the lead).
-TEST(CompiledModelFile, DISABLED_ReaderRefusesValuesItWouldMisread) {
+TEST(CompiledModelFile, ReaderRefusesValuesItWouldMisread) {
   json good = van_der_pol();
   // A guard, so that a relation can be broken.
   good["equations"][0]["known"]["terms"][0]["factors"].push_back(json::parse(R"({"kind": "guard", "conditions": [{

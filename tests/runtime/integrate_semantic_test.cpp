@@ -176,6 +176,17 @@ Truth time_product_rule(std::mt19937& rng) {
            {"u", [=](double t) { return a1 * (t * y(t, 1) + y(t)) + a2 * y(t); }}}};
 }
 
+// a1*der(abs(y), 2) + a2*y = x with y > 0.5 everywhere, so abs(y) = y is smooth: der() of a
+// function with no symbolic derivative, which the integrator lowers to der(abs(y), 1).
+Truth derivative_of_function(std::mt19937& rng) {
+  SmoothSignal y = random_signal(rng);
+  y.offset = 5.0;  // amplitudes are below 1.5 each: y >= 0.5
+  const double a1 = random_parameter(rng), a2 = random_parameter(rng);
+  return {{{"a1", a1}, {"a2", a2}},
+          {{"y", [=](double t) { return y(t); }},
+           {"x", [=](double t) { return a1 * y(t, 2) + a2 * y(t); }}}};
+}
+
 // a1*y'' + a2*[y' > 0]*y'^3 + a3*y = x: a guarded term.
 Truth guarded(std::mt19937& rng) {
   const SmoothSignal y = random_signal(rng);
@@ -215,6 +226,9 @@ std::vector<Case> cases() {
       {"TimeProductRuleOnceInitial",
        with_settings("input u\noutput y\nparam a1, a2\n", "set integrate = 1\nset constants = initial\n", "a1*(t*y' + y) + a2*y = u"),
        1, 0, true, time_product_rule},
+      {"DerivativeOfFunctionOnce",
+       with_settings("input x\noutput y\nparam a1, a2\n", "set integrate = 1\n", "a1*der(abs(y), 2) + a2*y = x"), 1, 1, false,
+       derivative_of_function},
       {"GuardedAuto", with_settings(kLinear2, "set integrate = auto\n", "a1*y'' + a2*[y' > 0]*y'^3 + a3*y = x"), 1, 1, false,
        guarded},
   };
@@ -400,6 +414,24 @@ TEST(IntegratedEquationMutation, DroppedInitialValuesAreCaught) {
   RecordProperty("broken_relative_residual", fmt::format("{:.3g}", measure(broken, truth, kFineIntervals).relative()));
   RecordProperty("broken_order", fmt::format("{:.2f}", std::log2(coarse / fine)));
   EXPECT_LT(std::log2(coarse / fine), 1.0) << coarse << " -> " << fine;
+}
+
+// int(der(u, 2)) = der(u, 1) under `constants = initial` must subtract der(u, 1) at t0; the
+// integrator gives `a1*der(abs(y), 1) + a2*int(y) = int(x)` with nothing subtracted (at_window_start
+// maps a derivative factor to 0), so the equation misses a1*der(abs(y), 1)(t0). Disabled until
+// integrate_pass either subtracts that value or keeps int(der(u, 2)) numerical in this mode.
+TEST(IntegratedEquationKnownIssue, DISABLED_DerivativeOfFunctionOnceInitial) {
+  const Case c{"DerivativeOfFunctionOnceInitial",
+               with_settings("input x\noutput y\nparam a1, a2\n", "set integrate = 1\nset constants = initial\n",
+                             "a1*der(abs(y), 2) + a2*y = x"),
+               1, 0, false, derivative_of_function};
+  const auto model = integrated_model(c);
+  ASSERT_TRUE(model);
+  std::mt19937 rng(kSeed);
+  const Truth truth = c.truth(rng);
+  const Residual r = measure(*model, truth, kFineIntervals);
+  EXPECT_LT(r.relative(), accuracy_bound(c)) << print(model->equations[0], *model) << "\n  max |residual| = " << r.max_abs
+                                             << ", scale = " << r.scale;
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, IntegratedEquation, ::testing::ValuesIn(cases()),

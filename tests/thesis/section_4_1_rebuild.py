@@ -18,6 +18,7 @@ Subcommands (run from anywhere; see docs/thesis-reproduction.md for their output
   eight-digit                   the same least squares, normal equations formed and solved in
                                 8-significant-digit decimal arithmetic (several 1964 variants).
   integrated                    eq. 4-1.11 (odd row) under variations of rule, input, t0, Delta.
+  integrated-table              eq. 4-1.11 for all eight combinations, 50 and 8 digits.
   quadrants                     Table 4-1.1 counted several ways.
 """
 import argparse
@@ -391,6 +392,23 @@ def cmd_integrated(args):
                   f"%E[m]={abs(m - 0.051813) / 0.051813 * 100:.2f}")
 
 
+def cmd_integrated_table(args):
+    """The eight combinations in the integrated form 4-1.11: the thesis says the odd one again had
+    the smallest G(a) at both Delta, which exact least squares cannot give for nested models."""
+    print(f"{'row':14} {'p':>3} {'G 50 digits':>24} {'G 8 digits (Gauss-Jordan, rounded)':>36}")
+    print(f"{'':14} {'':3} {'D=0.010':>11} {'D=0.020':>12} {'D=0.010':>17} {'D=0.020':>18}")
+    for name, powers, _ in COMBINATIONS:
+        exact, eight = [], []
+        for every in (1, 2):
+            X, b = integrated_form(every, powers, context(REFERENCE))
+            exact.append(float(least_squares(X, b, REFERENCE, scaled=True)[1]))
+            X, b = integrated_form(every, powers, context(8))
+            g = least_squares(X, b, 8, method="gauss-jordan")[1]
+            eight.append(float("nan") if g is None else float(g))
+        print(f"{name:14} {2 + 4 * len(powers):3d} {exact[0]:11.5f} {exact[1]:12.5f} "
+              f"{eight[0]:17.4g} {eight[1]:18.4g}")
+
+
 def cmd_quadrants(args):
     ref = context(REFERENCE)
     data = read_appendix_a()
@@ -436,6 +454,7 @@ def main():
     p.add_argument("--rows", nargs="*", help="only these rows of Table 4-1.2")
     p.set_defaults(run=cmd_eight_digit)
     sub.add_parser("integrated").set_defaults(run=cmd_integrated)
+    sub.add_parser("integrated-table").set_defaults(run=cmd_integrated_table)
     sub.add_parser("quadrants").set_defaults(run=cmd_quadrants)
     args = parser.parse_args()
     args.run(args)

@@ -31,19 +31,20 @@ struct FitArguments {
   std::string weights;
 };
 
-// The compiled model to fit when none is named: the only *.sidc.json in the current directory.
+// The compiled model to fit when none is named: the most recently compiled *.sidc.json in the
+// current directory, so that `sidc compile model.sid && sidc fit` fits that model.
 std::optional<std::string> default_compiled_model(std::string& error) {
-  std::vector<std::string> found;
+  std::vector<std::pair<fs::file_time_type, std::string>> found;
   for (const auto& entry : fs::directory_iterator(fs::current_path()))
-    if (entry.is_regular_file() && entry.path().filename().string().ends_with(".sidc.json")) found.push_back(entry.path().filename().string());
-  std::sort(found.begin(), found.end());
-  if (found.size() == 1) return found.front();
-  if (found.empty())
+    if (entry.is_regular_file() && entry.path().filename().string().ends_with(".sidc.json"))
+      found.emplace_back(entry.last_write_time(), entry.path().filename().string());
+  if (found.empty()) {
     error = "error: no compiled model (*.sidc.json) in this directory\nhint: run `sidc compile model.sid` first, or name one: `sidc fit model.sidc.json`";
-  else
-    error = fmt::format("error: {} compiled models in this directory ({}); name the one to fit\nhint: `sidc fit {}`", found.size(),
-                        fmt::join(found, ", "), found.front());
-  return std::nullopt;
+    return std::nullopt;
+  }
+  std::sort(found.begin(), found.end());  // by time, then name: deterministic
+  if (found.size() > 1) std::cerr << fmt::format("note: fitting `{}`, the most recently compiled model here\n", found.back().second);
+  return found.back().second;
 }
 
 std::optional<CompiledModel> load_compiled(const std::string& path, std::string& error) {
@@ -315,7 +316,7 @@ int run_fit(const FitArguments& a) {
 void add_fit_command(CLI::App& app, int& exit_status) {
   auto a = std::make_shared<FitArguments>();
   CLI::App* cmd = app.add_subcommand("fit", "Determine the parameters of a compiled model from records (thesis section 2-1)");
-  cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json); default: the only one in this directory");
+  cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json); default: the most recent one here");
   cmd->add_option("--data", a->data, "Record(s) to fit instead of the model's data statements (CSV)");
   cmd->add_option("--from", a->from, "Start of the fit window (time)");
   cmd->add_option("--to", a->to, "End of the fit window (time)");

@@ -1,6 +1,7 @@
 #include "compiler/integrate_pass.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <fmt/format.h>
 
 #include "compiler/differentiate.hpp"
@@ -93,8 +94,19 @@ std::optional<Sum> factor_at_window_start(const Factor& f) {
     case FactorKind::parameter:
     case FactorKind::window_start:
     case FactorKind::initial_value: return ir::factor(f);
-    default: return std::nullopt;  // never in an exact antiderivative
+    default: return std::nullopt;  // a derivative or guard factor: no value at t0 in the IR
   }
+}
+
+// True when F(t0) can be written with initial values (signals, time, functions of them).
+bool has_value_at_window_start(const Sum& s) {
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) {
+      if (f.kind == FactorKind::integral) continue;  // vanishes at t0 whatever it holds
+      if (!factor_at_window_start(f)) return false;
+      if ((f.kind == FactorKind::function || f.kind == FactorKind::power) && !has_value_at_window_start(*f.argument)) return false;
+    }
+  return true;
 }
 Sum at_window_start(const Sum& s) {
   std::vector<Term> terms;
@@ -102,7 +114,8 @@ Sum at_window_start(const Sum& s) {
     Sum product = ir::number(t.coefficient, t.span);
     for (const auto& [f, power] : t.factors) {
       auto value = factor_at_window_start(f);
-      Sum p = value ? *value : Sum{};
+      if (!value) throw std::logic_error("an antiderivative without a value at t0 reached at_window_start");
+      Sum p = *value;
       Sum raised = ir::number(1);
       if (power > 0) for (int k = 0; k < power; ++k) raised = ir::multiply(raised, p);
       else raised = power == 0 ? ir::number(1) : (p.empty() ? Sum{} : *raise(p, Number(power)));
@@ -126,7 +139,7 @@ bool take(std::vector<Term>& remaining, const Term& t) {
 // (t among them); those terms are removed. Candidates lower one derivative of a signal by one
 // order: for y^2*y' the candidate y^3 has derivative 3*y^2*y', so y^3/3; for x'*y the candidate
 // x*y has derivative x'*y + x*y', accepted only if x*y' is there too.
-std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remaining) {
+std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remaining, bool initial) {
   if (has_guard(t)) return std::nullopt;  // its antiderivative changes branch
   auto [constant, rest] = split_constant_part(t);
   // Powers of time alone: t^a -> t^(a+1)/(a+1), tau^b -> tau^(b+1)/(b+1), 1 -> tau.
@@ -144,6 +157,9 @@ std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remain
   if (rest.factors.size() == 1 && rest.factors[0].first.kind == FactorKind::derivative && rest.factors[0].second == 1) {
     const Factor& d = rest.factors[0].first;
     Sum lower = d.order > 1 ? ir::factor(Factor{FactorKind::derivative, "", d.order - 1, {}, {}, d.argument, {}}) : *d.argument;
+    // With `constants = initial` the antiderivative's value at t0 must be written out; where it
+    // cannot (a derivative or guard inside), the term stays a numerical integral, zero at t0.
+    if (initial && !has_value_at_window_start(lower)) return std::nullopt;
     take(remaining, t);
     return ir::multiply(ir::canonical(std::vector<Term>{constant}), lower);
   }
@@ -250,7 +266,7 @@ Sum antiderivative(const Sum& s, bool initial) {
   std::vector<Term> remaining = s.terms, result;
   while (!remaining.empty()) {
     const Term t = remaining.front();
-    if (auto exact = exact_antiderivative(t, remaining)) {
+    if (auto exact = exact_antiderivative(t, remaining, initial)) {
       Sum piece = initial ? ir::subtract(*exact, at_window_start(*exact)) : *exact;
       result.insert(result.end(), piece.terms.begin(), piece.terms.end());
       continue;

@@ -7,8 +7,9 @@
 // symbolic derivative must give back exactly the terms it replaces: y'' -> y', y^2*y' -> y^3/3
 // (eq. 2-2.7), y'*y'' -> y'^2/2, x'*y + x*y' -> x*y, constants -> tau, der(u, k) -> der(u, k-1)),
 // and otherwise by a
-// numerical integral `int(...)`, nested on repeated integration (eq. 2-2.5). Guarded terms are
-// never integrated symbolically. Integration constants become new parameters C1, C2, ... on
+// numerical integral `int(...)`, nested on repeated integration (eq. 2-2.5). A guarded term is
+// never integrated symbolically (its antiderivative changes branch), except as der(..., k) by
+// definition; with `constants = initial` that happens only where the value at t0 can be written. Integration constants become new parameters C1, C2, ... on
 // tau^(N-1)/(N-1)!, ..., tau, 1 (eqs. 2-1.5, 2-2.4, 2-2.5), or, with `constants = initial`, each
 // antiderivative has its value at t0 subtracted (eqs. 2-1.4, 4-2.4). Pinned by
 // tests/golden/integrated/.

@@ -219,6 +219,6 @@ TEST_P(SidcBinaryNist, MatchesCertifiedValuesToTheRequiredDigits) {
 }
 
 INSTANTIATE_TEST_SUITE_P(StRD, SidcBinaryNist, ::testing::ValuesIn(kSets),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& param) { return param.param; });
 
 }  // namespace

@@ -395,18 +395,20 @@ def cmd_integrated(args):
 def cmd_integrated_table(args):
     """The eight combinations in the integrated form 4-1.11: the thesis says the odd one again had
     the smallest G(a) at both Delta, which exact least squares cannot give for nested models."""
-    print(f"{'row':14} {'p':>3} {'G 50 digits':>24} {'G 8 digits (Gauss-Jordan, rounded)':>36}")
-    print(f"{'':14} {'':3} {'D=0.010':>11} {'D=0.020':>12} {'D=0.010':>17} {'D=0.020':>18}")
-    for name, powers, _ in COMBINATIONS:
-        exact, eight = [], []
-        for every in (1, 2):
+    names = ["50 digits"] + [title.replace("8 digits, ", "8 d. ") for title, _ in EIGHT_DIGIT_VARIANTS]
+    for every in (1, 2):
+        print(f"Delta = {0.01 * every:.3f}: G(a) of eq. 4-1.11; columns: " + "; ".join(
+            f"({i}) {n}" for i, n in enumerate(names)))
+        print(f"  {'row':14} {'p':>3}" + "".join(f"{f'({i})':>11}" for i in range(len(names))))
+        for name, powers, _ in COMBINATIONS:
             X, b = integrated_form(every, powers, context(REFERENCE))
-            exact.append(float(least_squares(X, b, REFERENCE, scaled=True)[1]))
-            X, b = integrated_form(every, powers, context(8))
-            g = least_squares(X, b, 8, method="gauss-jordan")[1]
-            eight.append(float("nan") if g is None else float(g))
-        print(f"{name:14} {2 + 4 * len(powers):3d} {exact[0]:11.5f} {exact[1]:12.5f} "
-              f"{eight[0]:17.4g} {eight[1]:18.4g}")
+            gs = [float(least_squares(X, b, REFERENCE, scaled=True)[1])]
+            for _, options in EIGHT_DIGIT_VARIANTS:
+                X, b = integrated_form(every, powers, context(8, options.get("rounding",
+                                                                            decimal.ROUND_HALF_EVEN)))
+                g = least_squares(X, b, 8, **options)[1]
+                gs.append(float("nan") if g is None else float(g))
+            print(f"  {name:14} {2 + 4 * len(powers):3d}" + "".join(f"{g:11.4g}" for g in gs))
 
 
 def cmd_quadrants(args):
@@ -445,7 +447,9 @@ def cmd_quadrants(args):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        description="Thesis section 4-1 rebuilt by hand, independently of sidc "
+                    "(docs/thesis-reproduction.md).")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("table-4-1-2")
     p.add_argument("--results", help="directory with <row>.<every>/fit.json from sidc fit --out")

@@ -5,9 +5,9 @@
 // Relies on: the sidc binary (SIDC_BINARY, the CMake target's file), the models and record in
 // examples/thesis-4-1 (SIDC_THESIS_EXAMPLE_DIR), a writable scratch folder in the build tree
 // (SIDC_THESIS_WORK_DIR), and the fit.json format of `sidc fit --out` (groups[].statistics,
-// .parameters, .regions). Guarantees: each test copies the example folder's layout (the models'
-// data path "../appendix_a.csv" is relative to the compiled model) into a scratch folder of its
-// own, so tests can run in parallel and the source tree is never written; it then runs exactly
+// .parameters, .regions). Guarantees: each test copies the example folder's layout (the models
+// find "../appendix_a.csv" by a relative path) into a scratch folder of its own, so tests can
+// run in parallel and the source tree is never written; it then runs exactly
 // the commands a user runs (`sidc compile X.sid`, `sidc fit X.sidc.json [--every 2] --out DIR`)
 // and reads fit.json. A failing command fails the test with the command and its output.
 #include <cstdlib>
@@ -26,8 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// The thesis' printed values (Tables 4-1.1, 4-1.2, eq. 4-1.2 and the text after Table 4-1.2).
-constexpr double kTrueMass = 0.051813;  // eq. 4-1.2
+constexpr double kTrueMass = 0.051813;  // the value the thesis chose, eq. 4-1.2
 
 // Single-quoted for the shell (scratch paths under the build tree hold no quote). Built with +=
 // because GCC 12 gives a false -Wrestrict warning on "'" + std::string + "'".
@@ -132,9 +131,10 @@ class ThesisSection41 : public ::testing::Test {
 };
 
 // Table 4-1.1. n is eq. 4-1.10 exactly. The quadrant counts are sidc's own (the guards evaluated
-// on y and the estimated y'); the thesis prints IV = 21 at Delta = 0.010, which makes its four
-// counts add to 79 against its n = 77: it counted the two rows next to the I/IV boundary
-// (t = 0.21 and 0.72, y' = 0.5 and 0.8) in both quadrants. docs/thesis-reproduction.md, finding 3.
+// on y and the estimated y'). The thesis prints IV = 21 at Delta = 0.010, which makes its four
+// counts add to 79 against its own n = 77; counting the two rows next to the I/IV boundary
+// (t = 0.21 and 0.72, y' about 0.5) in both quadrants would give its numbers, but only at
+// Delta = 0.010 (docs/thesis-reproduction.md, finding 3). The Delta = 0.020 counts are the thesis'.
 TEST_F(ThesisSection41, Table411CountsAtDelta0010) {
   const json group = fit("table_4_1_2/odd", 1);
   ASSERT_FALSE(group.is_null());

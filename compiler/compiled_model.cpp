@@ -36,16 +36,6 @@ std::optional<FactorKind> kind_from(const std::string& s) {
   return std::nullopt;
 }
 
-const char* relation_name(ir::Relation r) {
-  switch (r) {
-    case ir::Relation::less: return "<";
-    case ir::Relation::less_equal: return "<=";
-    case ir::Relation::greater: return ">";
-    case ir::Relation::greater_equal: return ">=";
-  }
-  return "<";
-}
-
 ordered number_json(const Number& n) {
   if (n.exact()) return ordered{{"num", n.numerator()}, {"den", n.denominator()}};
   return ordered{{"real", n.value()}};
@@ -75,7 +65,7 @@ ordered factor_json(const ir::Factor& f, int power) {
     case FactorKind::guard: {
       ordered conditions = ordered::array();
       for (const auto& c : f.conditions)
-        conditions.push_back(ordered{{"lhs", sum_json(*c.lhs)}, {"relation", relation_name(c.relation)}, {"rhs", sum_json(*c.rhs)}});
+        conditions.push_back(ordered{{"lhs", sum_json(*c.lhs)}, {"relation", ir::to_string(c.relation)}, {"rhs", sum_json(*c.rhs)}});
       j["conditions"] = std::move(conditions);
       break;
     }

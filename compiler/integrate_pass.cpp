@@ -19,30 +19,6 @@ using ir::Term;
 
 Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
 
-int burden(const Sum& s);
-int burden(const Factor& f) {
-  switch (f.kind) {
-    case FactorKind::signal:
-    case FactorKind::initial_value: return f.order;
-    case FactorKind::derivative: return f.order + burden(*f.argument);
-    case FactorKind::function:
-    case FactorKind::power:
-    case FactorKind::integral: return burden(*f.argument);
-    case FactorKind::guard: {
-      int b = 0;
-      for (const auto& c : f.conditions) b = std::max({b, burden(*c.lhs), burden(*c.rhs)});
-      return b;
-    }
-    default: return 0;
-  }
-}
-int burden(const Sum& s) {
-  int b = 0;
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) b = std::max(b, burden(f));
-  return b;
-}
-
 // Anything that changes with time: a static equation (a plain regression) has none of these.
 bool is_dynamic(const Sum& s);
 bool is_dynamic(const Factor& f) {
@@ -248,8 +224,8 @@ struct Integrator {
 }  // namespace
 
 int derivative_burden(const ir::Equation& e) {
-  int b = burden(e.known);
-  for (const auto& p : e.terms) b = std::max(b, burden(p.operation));
+  int b = ir::highest_derivative_order(e.known);
+  for (const auto& p : e.terms) b = std::max(b, ir::highest_derivative_order(p.operation));
   return b;
 }
 

@@ -120,6 +120,42 @@ int compare(const Sum& a, const Sum& b) {
   return three_way(a.terms.size(), b.terms.size());
 }
 
+const char* to_string(Relation r) {
+  switch (r) {
+    case Relation::less: return "<";
+    case Relation::less_equal: return "<=";
+    case Relation::greater: return ">";
+    case Relation::greater_equal: return ">=";
+  }
+  return "<";
+}
+
+namespace {
+int highest_derivative_order(const Factor& f) {
+  switch (f.kind) {
+    case FactorKind::signal:
+    case FactorKind::initial_value: return f.order;
+    case FactorKind::derivative: return f.order + highest_derivative_order(*f.argument);
+    case FactorKind::function:
+    case FactorKind::power:
+    case FactorKind::integral: return highest_derivative_order(*f.argument);
+    case FactorKind::guard: {
+      int k = 0;
+      for (const auto& c : f.conditions) k = std::max({k, highest_derivative_order(*c.lhs), highest_derivative_order(*c.rhs)});
+      return k;
+    }
+    default: return 0;
+  }
+}
+}  // namespace
+
+int highest_derivative_order(const Sum& s) {
+  int k = 0;
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) k = std::max(k, highest_derivative_order(f));
+  return k;
+}
+
 std::optional<Number> Sum::as_number() const {
   if (terms.empty()) return Number(0);
   if (terms.size() == 1 && terms[0].is_number()) return terms[0].coefficient;

@@ -84,6 +84,13 @@ struct Sum {
 };
 
 int compare(const Sum& a, const Sum& b);  // total order, coefficients included
+
+// `<`, `<=`, `>`, `>=`: as written in the language (and in the compiled model file).
+const char* to_string(Relation r);
+
+// The highest derivative order anywhere in the sum, inside integrals, functions and guards too
+// (a der() of a derivative adds up): what estimating it from data costs.
+int highest_derivative_order(const Sum& s);
 inline bool operator==(const Sum& a, const Sum& b) { return compare(a, b) == 0; }
 
 // ---- construction and arithmetic (all results canonical) --------------------------------------

@@ -7,16 +7,6 @@ namespace {
 
 using ir::FactorKind;
 
-const char* relation_text(ir::Relation r) {
-  switch (r) {
-    case ir::Relation::less: return "<";
-    case ir::Relation::less_equal: return "<=";
-    case ir::Relation::greater: return ">";
-    case ir::Relation::greater_equal: return ">=";
-  }
-  return "<";
-}
-
 // A sum that needs no parentheses as the base of `^` or as a factor: one factor, coefficient 1.
 bool is_atom(const ir::Sum& s) {
   return s.terms.size() == 1 && s.terms[0].coefficient.is_one() && s.terms[0].factors.size() == 1 &&
@@ -115,7 +105,7 @@ std::string print(const ir::Factor& f) {
       std::string out = "[";
       for (std::size_t i = 0; i < f.conditions.size(); ++i) {
         const auto& c = f.conditions[i];
-        out += fmt::format("{}{} {} {}", i ? " and " : "", print(*c.lhs), relation_text(c.relation), print(*c.rhs));
+        out += fmt::format("{}{} {} {}", i ? " and " : "", print(*c.lhs), ir::to_string(c.relation), print(*c.rhs));
       }
       return out + "]";
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "compiler/integrate_pass.hpp"
 #include "compiler/print.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
 #include "runtime/data_diagnostics.hpp"
@@ -13,30 +14,6 @@ namespace sidc {
 namespace {
 
 using ir::FactorKind;
-
-int order_of(const ir::Sum& s);
-int order_of(const ir::Factor& f) {
-  switch (f.kind) {
-    case FactorKind::signal:
-    case FactorKind::initial_value: return f.order;
-    case FactorKind::derivative: return f.order + order_of(*f.argument);
-    case FactorKind::function:
-    case FactorKind::power:
-    case FactorKind::integral: return order_of(*f.argument);
-    case FactorKind::guard: {
-      int k = 0;
-      for (const auto& c : f.conditions) k = std::max({k, order_of(*c.lhs), order_of(*c.rhs)});
-      return k;
-    }
-    default: return 0;
-  }
-}
-int order_of(const ir::Sum& s) {
-  int k = 0;
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) k = std::max(k, order_of(f));
-  return k;
-}
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
@@ -49,10 +26,7 @@ std::size_t index_at_or_after(const std::vector<double>& time, double t) {
 
 int highest_derivative_order(const ir::Model& model) {
   int k = 0;
-  for (const auto& e : model.equations) {
-    k = std::max(k, order_of(e.known));
-    for (const auto& p : e.terms) k = std::max(k, order_of(p.operation));
-  }
+  for (const auto& e : model.equations) k = std::max(k, derivative_burden(e));
   return k;
 }
 

@@ -162,6 +162,7 @@ std::string residuals_csv(const FitSummary& s) {
 // One model's fit, reported on stdout; its totals for a comparison table when asked.
 struct ModelTotals {
   std::string name;
+  std::string known;  // the known sides, printed: G(a) compares only models that share them
   std::size_t n = 0, p = 0;
   double G = 0;
   bool usable = false;
@@ -233,6 +234,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     totals->name = model.name.empty() ? compiled_path : model.name;
     totals->usable = summary.is_solution_usable();
     for (const auto& g : summary.groups) totals->n += g.summary.n, totals->p += g.summary.p, totals->G += g.summary.G;
+    for (const auto& equation : model.equations) totals->known += print(equation.known) + "; ";
   }
 
   if (!out_dir.empty()) {
@@ -257,11 +259,13 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
 
 // Section 2-1: "if the system equation has several alternate forms, that form which possesses a
 // minimum sum of the squares of the residuals will constitute the solution of best fit". G(a)
-// only compares forms with the same rows; AIC and BIC also weigh the number of parameters.
+// only compares forms fitted to the same rows with the same known side: the residuals of `= x`
+// and of `= int(x)` are in different units. AIC and BIC also weigh the number of parameters.
 std::string comparison_table(const std::vector<ModelTotals>& models) {
   std::string out = "\nmodel comparison (thesis Table 4-1.2; smaller is better in the last four columns):\n";
   out += fmt::format("  {:<28} {:>6} {:>4} {:>14} {:>12} {:>11} {:>11}\n", "model", "n", "p", "G(a)", "sqrt(G/n)", "AIC", "BIC");
   const bool same_rows = std::all_of(models.begin(), models.end(), [&](const ModelTotals& m) { return m.n == models.front().n; });
+  const bool same_known = std::all_of(models.begin(), models.end(), [&](const ModelTotals& m) { return m.known == models.front().known; });
   double best_g = INFINITY, best_aic = INFINITY, best_bic = INFINITY;
   std::vector<std::array<double, 2>> criteria;
   for (const auto& m : models) {
@@ -273,14 +277,18 @@ std::string comparison_table(const std::vector<ModelTotals>& models) {
   for (std::size_t i = 0; i < models.size(); ++i) {
     const auto& m = models[i];
     std::string marks;
-    if (m.usable && same_rows && m.G == best_g) marks += " least G";
-    if (m.usable && criteria[i][0] == best_aic) marks += " best AIC";
-    if (m.usable && criteria[i][1] == best_bic) marks += " best BIC";
+    if (m.usable && same_known && same_rows && m.G == best_g) marks += " least G";
+    if (m.usable && same_known && criteria[i][0] == best_aic) marks += " best AIC";
+    if (m.usable && same_known && criteria[i][1] == best_bic) marks += " best BIC";
     if (!m.usable) marks = " (rank deficient)";
     out += fmt::format("  {:<28} {:>6} {:>4} {:>14.6g} {:>12.4g} {:>11.4g} {:>11.4g}{}\n", m.name, m.n, m.p, m.G,
                        std::sqrt(m.G / static_cast<double>(m.n)), criteria[i][0], criteria[i][1], marks);
   }
-  if (!same_rows) out += "  (the models were fitted to different numbers of rows, so G(a) does not rank them; AIC and BIC do)\n";
+  if (!same_known)
+    out += "  (the models' known sides differ, as between a derivative and an integrated form, so their residuals\n"
+           "   are in different units: neither G(a) nor AIC and BIC rank them; compare them by their parameters)\n";
+  else if (!same_rows)
+    out += "  (the models were fitted to different numbers of rows, so G(a) does not rank them; AIC and BIC do)\n";
   return out;
 }
 

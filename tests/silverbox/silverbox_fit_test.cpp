@@ -89,7 +89,8 @@ double standard_deviation(const std::vector<double>& x, std::size_t first, std::
   return std::sqrt(sum / static_cast<double>(last - first));
 }
 
-// Where the phase of H = S_uy/S_uu crosses -45, -90 and -135 degrees between 30 and 120 Hz.
+// Where the phase of H = S_uy/S_uu crosses -45, -90 and -135 degrees between 50 and 90 Hz
+// (in this record the phase is above -10 degrees at 50 Hz and below -160 degrees at 90 Hz).
 // Welch's estimate: segments of 2048 samples, half overlapping, mean removed, Hann window; the
 // DFT is evaluated only at the bins of the band. Crossings are interpolated linearly in phase.
 struct PhaseCrossings {
@@ -100,8 +101,8 @@ struct PhaseCrossings {
 PhaseCrossings phase_crossings(const Record& r, std::size_t first, std::size_t last) {
   constexpr std::size_t kSegment = 2048;
   const double fs = 1.0 / kStep;
-  const auto bin_low = static_cast<std::size_t>(30.0 * kSegment / fs);
-  const auto bin_high = static_cast<std::size_t>(120.0 * kSegment / fs) + 1;
+  const auto bin_low = static_cast<std::size_t>(50.0 * kSegment / fs);
+  const auto bin_high = static_cast<std::size_t>(90.0 * kSegment / fs) + 1;
   std::vector<double> window(kSegment);
   for (std::size_t i = 0; i < kSegment; ++i) window[i] = 0.5 - 0.5 * std::cos(2.0 * kPi * i / kSegment);
   std::vector<std::complex<double>> suy(bin_high - bin_low + 1);

@@ -29,6 +29,8 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include "support/shell.hpp"
 #include <nlohmann/json.hpp>
 
 #include "nist_dataset.hpp"
@@ -36,6 +38,8 @@
 namespace {
 
 namespace fs = std::filesystem;
+using sidc::testing::read_text;
+using sidc::testing::shell_quoted;
 using nlohmann::json;
 using sidc::nist::log_relative_error;
 
@@ -46,30 +50,12 @@ const std::vector<std::string> kSets = {"Norris",   "Pontius",  "NoInt1",   "NoI
 // digits whatever the arithmetic (docs/accuracy.md, "The ceiling of the data").
 double required_digits(const std::string& set) { return set == "Filip" ? 7.0 : 9.0; }
 
-// Single-quoted for the shell, with embedded quotes closed, escaped and reopened.
-std::string quoted(const std::string& text) {
-  std::string out(1, '\'');
-  for (char c : text) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
-  }
-  out += '\'';
-  return out;
-}
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // Runs a command with stdout and stderr in `log`; returns "" on exit status 0, else what to show.
 std::string run(const std::string& command, const fs::path& log) {
-  const int status = std::system((command + " >" + quoted(log.string()) + " 2>&1").c_str());
+  const int status = std::system((command + " >" + shell_quoted(log.string()) + " 2>&1").c_str());
   if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
   const int code = status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : status;
-  return fmt::format("command failed (exit status {}): {}\n{}", code, command, slurp(log));
+  return fmt::format("command failed (exit status {}): {}\n{}", code, command, read_text(log));
 }
 
 // sidc's name for certified parameter "Bk": the family member b[k], or the plain name bk (NoInt1/2,
@@ -141,20 +127,20 @@ TEST_P(SidcBinaryNist, MatchesCertifiedValuesToTheRequiredDigits) {
   ASSERT_NE(mkdtemp(pattern.data()), nullptr) << "cannot create a temporary folder " << pattern;
   const fs::path work(pattern);
 
-  const std::string sidc = quoted(SIDC_BINARY);
+  const std::string sidc = shell_quoted(SIDC_BINARY);
   const fs::path compiled = work / (set + ".sidc.json");
   const fs::path out = work / "fit";
   const std::string compile_failure = run(
-      sidc + " compile " + quoted((nist / "models" / (set + ".sid")).string()) + " -o " + quoted(compiled.string()),
+      sidc + " compile " + shell_quoted((nist / "models" / (set + ".sid")).string()) + " -o " + shell_quoted(compiled.string()),
       work / "compile.txt");
   ASSERT_EQ(compile_failure, "") << "kept " << work;
   const std::string fit_failure =
-      run(sidc + " fit " + quoted(compiled.string()) + " --out " + quoted(out.string()), work / "fit.txt");
+      run(sidc + " fit " + shell_quoted(compiled.string()) + " --out " + shell_quoted(out.string()), work / "fit.txt");
   ASSERT_EQ(fit_failure, "") << "kept " << work;
 
   json fit;
   try {
-    fit = json::parse(slurp(out / "fit.json"));
+    fit = json::parse(read_text(out / "fit.json"));
   } catch (const json::exception& e) {
     FAIL() << "fit.json does not parse: " << e.what() << "; kept " << work;
   }
@@ -204,7 +190,7 @@ TEST_P(SidcBinaryNist, MatchesCertifiedValuesToTheRequiredDigits) {
 
   // The printed report tells the user how far to trust these numbers: its "digits lost" line is
   // fit.json's estimate, and it warns exactly when fewer than 4 digits are to be expected.
-  const std::string report = slurp(work / "fit.txt");
+  const std::string report = read_text(work / "fit.txt");
   std::smatch lost;
   ASSERT_TRUE(std::regex_search(report, lost, std::regex(R"(about (\d+\.\d) digits lost)"))) << report;
   EXPECT_EQ(lost[1].str(), fmt::format("{:.1f}", scores.digits_lost));

@@ -30,11 +30,15 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "support/shell.hpp"
 #include <nlohmann/json.hpp>
 
 namespace {
 
 namespace fs = std::filesystem;
+using sidc::testing::read_text;
+using sidc::testing::shell_quoted;
 using nlohmann::json;
 
 constexpr double kStep = 0.0016384;  // 2^14/1e7 s, the exact sampling step
@@ -43,20 +47,6 @@ constexpr double kPi = std::numbers::pi;
 // The benchmark's sections (0-based, half open), examples/silverbox/README.md.
 constexpr std::size_t kLowAmplitudeFirst = 100, kLowAmplitudeLast = 10100;  // start of the arrow
 constexpr std::size_t kSectionFirst = 40650, kSectionLast = 105712;         // the models' section
-
-std::string quoted(const fs::path& p) {
-  std::string s(1, '\'');
-  s += p.string();
-  s += '\'';
-  return s;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // V1 and V2 of SNLS80mV.csv: a quoted header, then "v1,v2," per line.
 struct Record {
@@ -215,15 +205,15 @@ class Silverbox : public ::testing::Test {
 
   // `sidc compile <model>.sid && sidc fit <model>.sidc.json --out out.<model>`; a null group on failure.
   static json fit(const std::string& model) {
-    const std::string binary = quoted(fs::path(SIDC_BINARY));
+    const std::string binary = shell_quoted(fs::path(SIDC_BINARY));
     const fs::path log = work_ / (model + ".log");
-    const std::string command = binary + " compile " + quoted(work_ / (model + ".sid")) + " && " + binary + " fit " +
-                                quoted(work_ / (model + ".sidc.json")) + " --out " + quoted(work_ / ("out." + model));
-    if (std::system(("(" + command + ") >" + quoted(log) + " 2>&1").c_str()) != 0) {
-      std::cout << "command failed: " << command << "\n" << slurp(log);
+    const std::string command = binary + " compile " + shell_quoted(work_ / (model + ".sid")) + " && " + binary + " fit " +
+                                shell_quoted(work_ / (model + ".sidc.json")) + " --out " + shell_quoted(work_ / ("out." + model));
+    if (std::system(("(" + command + ") >" + shell_quoted(log) + " 2>&1").c_str()) != 0) {
+      std::cout << "command failed: " << command << "\n" << read_text(log);
       return json();
     }
-    return json::parse(slurp(work_ / ("out." + model) / "fit.json")).at("groups").at(0);
+    return json::parse(read_text(work_ / ("out." + model) / "fit.json")).at("groups").at(0);
   }
 
   static inline fs::path work_;

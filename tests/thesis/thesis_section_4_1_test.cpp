@@ -19,30 +19,18 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "support/shell.hpp"
 #include <nlohmann/json.hpp>
 
 namespace {
 
 namespace fs = std::filesystem;
+using sidc::testing::read_text;
+using sidc::testing::shell_quoted;
 using nlohmann::json;
 
 constexpr double kTrueMass = 0.051813;  // the value the thesis chose, eq. 4-1.2
-
-// Single-quoted for the shell (scratch paths under the build tree hold no quote). Built with +=
-// because GCC 12 gives a false -Wrestrict warning on "'" + std::string + "'".
-std::string quoted(const fs::path& p) {
-  std::string s(1, '\'');
-  s += p.string();
-  s += '\'';
-  return s;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // One scratch copy of examples/thesis-4-1 per test, and the two sidc commands on it.
 class ThesisSection41 : public ::testing::Test {
@@ -65,9 +53,9 @@ class ThesisSection41 : public ::testing::Test {
 
   // Runs a shell command with its output in a log; returns "" on success, else what to show.
   std::string run(const std::string& command, const fs::path& log) {
-    const int status = std::system((command + " >" + quoted(log) + " 2>&1").c_str());
+    const int status = std::system((command + " >" + shell_quoted(log) + " 2>&1").c_str());
     if (status == 0) return "";
-    return "command failed (status " + std::to_string(status) + "): " + command + "\n" + slurp(log);
+    return "command failed (status " + std::to_string(status) + "): " + command + "\n" + read_text(log);
   }
 
   // `sidc compile <model>` then `sidc fit <model>.sidc.json [--every K] --out DIR [extra]`;
@@ -79,10 +67,10 @@ class ThesisSection41 : public ::testing::Test {
     for (char& c : label)
       if (c == '/') c = '_';
     const fs::path out = work_ / ("out." + label);
-    const std::string binary = quoted(fs::path(SIDC_BINARY));
-    std::string failure = run(binary + " compile " + quoted(source), work_ / (label + ".compile.log"));
+    const std::string binary = shell_quoted(fs::path(SIDC_BINARY));
+    std::string failure = run(binary + " compile " + shell_quoted(source), work_ / (label + ".compile.log"));
     if (failure.empty()) {
-      std::string command = binary + " fit " + quoted(compiled) + " --out " + quoted(out);
+      std::string command = binary + " fit " + shell_quoted(compiled) + " --out " + shell_quoted(out);
       if (every != 1) command += " --every " + std::to_string(every);
       if (!extra.empty()) command += " " + extra;
       failure = run(command, work_ / (label + ".fit.log"));
@@ -91,7 +79,7 @@ class ThesisSection41 : public ::testing::Test {
       ADD_FAILURE() << failure;
       return json();
     }
-    const json result = json::parse(slurp(out / "fit.json"));
+    const json result = json::parse(read_text(out / "fit.json"));
     EXPECT_EQ(result.at("groups").size(), 1u) << model;
     return result.at("groups").at(0);
   }

@@ -10,6 +10,7 @@
 #include "cli/exit_codes.hpp"
 #include "cli/read_file.hpp"
 #include "compiler/compiled_model.hpp"
+#include "compiler/pipeline.hpp"
 #include "compiler/print.hpp"
 #include "compiler/settings.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
@@ -50,6 +51,17 @@ std::optional<std::string> default_compiled_model(std::string& error) {
 std::optional<CompiledModel> load_compiled(const std::string& path, std::string& error) {
   auto text = read_whole_file(path, error);
   if (!text) return std::nullopt;
+  if (path.ends_with(".sid")) {  // a model file: compiled here, in memory, nothing written
+    auto source = std::make_shared<const SourceFile>(path, std::move(*text));
+    CompileResult r = compile(source, {});
+    if (!r.ok()) {
+      error = r.diagnostics.render_all();
+      if (!error.empty() && error.back() == '\n') error.pop_back();
+      return std::nullopt;
+    }
+    std::cerr << r.diagnostics.render_all();  // warnings
+    return CompiledModel{source, *r.normalized, *r.integrated};
+  }
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(*text, nullptr, false);
   if (j.is_discarded()) {
     error = fmt::format("error: `{}` is not JSON; compile the model again with `sidc compile`", path);
@@ -324,7 +336,7 @@ int run_fit(const FitArguments& a) {
 void add_fit_command(CLI::App& app, int& exit_status) {
   auto a = std::make_shared<FitArguments>();
   CLI::App* cmd = app.add_subcommand("fit", "Determine the parameters of a compiled model from records (thesis section 2-1)");
-  cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json); default: the most recent one here");
+  cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json), or model files (.sid) to compile first; default: the most recent compiled model here");
   cmd->add_option("--data", a->data, "Record(s) to fit instead of the model's data statements (CSV)");
   cmd->add_option("--from", a->from, "Start of the fit window (time)");
   cmd->add_option("--to", a->to, "End of the fit window (time)");

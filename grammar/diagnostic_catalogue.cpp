@@ -381,9 +381,9 @@ Diagnostic integrate_option_invalid(std::string_view value) {
 Diagnostic no_signal(const Span& where) {
   return error("no-signal", where, "this equation uses no signal", "an equation relates signals, e.g. `a1*y' + a2*y = x`");
 }
-Diagnostic operation_not_finite(const Span& where, std::string_view operation, double time, std::string_view record) {
+Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record) {
   return error("operation-not-finite", where,
-               fmt::format("`{}` is not a finite number at t = {} in `{}`", operation, time, record),
+               fmt::format("`{}`{} is not a finite number at t = {} in `{}`", operation, owner.empty() ? "" : fmt::format(" ({})", owner), time, record),
                "check the record there (a zero under a division or a log, a huge power), or narrow the fit window with `set from`/`set to`");
 }
 

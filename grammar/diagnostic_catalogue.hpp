@@ -122,7 +122,7 @@ Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::st
 Diagnostic integrate_option_invalid(std::string_view value);
 Diagnostic no_signal(const Span& where);
 // ---- evaluation on data (runtime/), pointing at the model text
-Diagnostic operation_not_finite(const Span& where, std::string_view operation, double time, std::string_view record);
+Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record);
 Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);
 Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last);
 Diagnostic no_data_file(const Span& where);

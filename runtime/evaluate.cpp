@@ -229,8 +229,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate_in_window(cons
       const double x = v[window_.first + i];
       if (!std::isfinite(x)) {
         const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
-        return diag::operation_not_finite(t.span, what.empty() ? print(single) : what + ": " + print(single),
-                                          record_.time[window_.first + i], record_.path);
+        return diag::operation_not_finite(t.span, print(single), what, record_.time[window_.first + i], record_.path);
       }
       total[i] += x;
     }

@@ -62,7 +62,8 @@ class Evaluator {
 
   // The sum's value at every sample of the record; NaN where it has none.
   std::variant<std::vector<double>, Diagnostic> evaluate(const ir::Sum& s);
-  // The same, cut to the fit window, with an error naming the operation if a value in it is not finite.
+  // The same, cut to the fit window, with an error naming the term if a value in it is not finite;
+  // `what` says whose term it is ("the operation of `a1`", "the known side").
   std::variant<std::vector<double>, Diagnostic> evaluate_in_window(const ir::Sum& s, const std::string& what);
 
   const FitWindow& window() const { return window_; }

@@ -36,7 +36,7 @@ std::variant<std::vector<Region>, Diagnostic> count_regions(const ir::Model& mod
   for (auto& evaluator : evaluators) {
     std::vector<std::vector<double>> values;
     for (const auto& [text, f] : guards) {
-      auto v = evaluator.evaluate_in_window(ir::factor(f), "guard " + text);
+      auto v = evaluator.evaluate_in_window(ir::factor(f), "a region guard");
       if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
       values.push_back(std::get<std::vector<double>>(std::move(v)));
     }
@@ -136,7 +136,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
           const auto& parameter = model.parameters[static_cast<std::size_t>(p.parameter)];
           const bool per_record = parameter.origin == ir::Parameter::Origin::integration_constant && records.size() > 1;
           const std::size_t column = column_of.at({p.parameter, per_record ? r : 0});
-          auto values = evaluators[r].evaluate_in_window(p.operation, parameter.name);
+          auto values = evaluators[r].evaluate_in_window(p.operation, "the operation of `" + parameter.name + "`");
           if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
           const auto& v = std::get<std::vector<double>>(values);
           for (std::size_t i = 0; i < v.size(); ++i) A(static_cast<Eigen::Index>(row + i), static_cast<Eigen::Index>(column)) = v[i];

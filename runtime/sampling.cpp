@@ -115,16 +115,27 @@ std::vector<double> decimate(std::span<const double> values, std::size_t every, 
   return out;
 }
 
-Record select_rows(const Record& record, IndexRange rows, std::size_t every) {
-  if (every == 0) every = 1;
-  rows.end = std::min(rows.end, record.rows());
-  rows.begin = std::min(rows.begin, rows.end);
+namespace {
+
+// An empty record that still knows the file it came from: names, faults and line numbers, so that
+// rows selected or resampled from it are reported at their lines in the file.
+Record same_file_as(const Record& record) {
   Record out;
   out.path = record.path;
   out.names = record.names;
   out.first_faults = record.first_faults;
   out.header_line = record.header_line;
   out.line_jumps = record.line_jumps;
+  return out;
+}
+
+}  // namespace
+
+Record select_rows(const Record& record, IndexRange rows, std::size_t every) {
+  if (every == 0) every = 1;
+  rows.end = std::min(rows.end, record.rows());
+  rows.begin = std::min(rows.begin, rows.end);
+  Record out = same_file_as(record);
   out.interpolated_from = record.interpolated_from;
   out.origin_first = record.origin_first + rows.begin * record.origin_stride;
   out.origin_stride = record.origin_stride * every;
@@ -184,12 +195,7 @@ std::variant<Record, Diagnostic> resample_linear(const Record& record, std::stri
   }
   if (!(step > 0) || !std::isfinite(step)) return data_diag::invalid_resampling_step(step);
   ResampledSignals signals = resample_linear(time, record.columns, step);
-  Record out;
-  out.path = record.path;
-  out.names = record.names;
-  out.first_faults = record.first_faults;
-  out.header_line = record.header_line;
-  out.line_jumps = record.line_jumps;
+  Record out = same_file_as(record);
   // The time column is the grid itself, not an interpolation of it.
   signals.columns[*record.column_index(time_column)] = signals.time;
   out.columns = std::move(signals.columns);

@@ -13,8 +13,9 @@
 //   `sidc fit` (runtime/fit.cpp builds the design the same way); each reports wall time, rows per
 //   second, CPU time / wall time (how many cores were busy), resident memory after the phase and
 //   the process's peak so far (getrusage ru_maxrss, a high-water mark: it never goes down).
-// - The command-line path `sidc compile && sidc fit` runs as child processes; their peak memory
-//   comes from wait4()'s rusage, so it is the child's own, not this process's.
+// - The command-line path `sidc compile && sidc fit` runs as child processes, before the
+//   in-process phases; their peak memory comes from wait4()'s rusage, so it is the child's own
+//   (plus at most this process's resident size at the fork, printed: a few MB).
 // - PASS/FAIL is judged against the targets: the whole fit, CSV to report, in under 3 s,
 //   with peak memory under 1 GB (10^9 bytes). MB here is always 10^6 bytes.
 #include <charconv>
@@ -202,10 +203,22 @@ std::string model_text(const std::string& csv_name) {
 
 double seconds_of(const timeval& tv) { return static_cast<double>(tv.tv_sec) + 1e-6 * static_cast<double>(tv.tv_usec); }
 
-double cpu_seconds_self() {
+struct CpuTime {
+  double user = 0, system = 0;
+};
+
+CpuTime cpu_time_self() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
-  return seconds_of(u.ru_utime) + seconds_of(u.ru_stime);
+  return {seconds_of(u.ru_utime), seconds_of(u.ru_stime)};
+}
+
+// Other processes on the machine slow every phase down; the load average says whether they did.
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  if (!(in >> one >> five >> fifteen)) return "unknown";
+  return fmt::format("{} {} {} (1, 5, 15 min)", one, five, fifteen);
 }
 
 double peak_mb_self() {
@@ -226,7 +239,8 @@ struct Phase {
   double seconds = 0;
   double rows = 0;       // rows handled (0: no rate)
   double megabytes = 0;  // bytes handled / 10^6 (0: no rate)
-  double cpu_seconds = 0;
+  double cpu_seconds = 0;     // user + system, all threads
+  double system_seconds = 0;  // of which in the kernel (page faults of fresh allocations, mostly)
   double resident_mb = NAN;  // after the phase
   double peak_mb = NAN;      // the process's peak so far (or the child's peak)
   bool counts_to_total = true;
@@ -238,11 +252,20 @@ std::vector<Phase> phases;
 bool measure(const std::string& name, double rows, const std::function<bool()>& work, double megabytes = 0,
              bool counts_to_total = true) {
   std::cout << fmt::format("  {:<40}", name) << std::flush;
-  const double cpu0 = cpu_seconds_self();
+  const CpuTime cpu0 = cpu_time_self();
   const auto t0 = Clock::now();
   const bool ok = work();
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  Phase p{name, seconds, rows, megabytes, cpu_seconds_self() - cpu0, resident_mb_self(), peak_mb_self(), counts_to_total};
+  const CpuTime cpu1 = cpu_time_self();
+  Phase p{name,
+          seconds,
+          rows,
+          megabytes,
+          cpu1.user + cpu1.system - cpu0.user - cpu0.system,
+          cpu1.system - cpu0.system,
+          resident_mb_self(),
+          peak_mb_self(),
+          counts_to_total};
   std::cout << fmt::format("{:8.3f} s   peak {:8.1f} MB\n", p.seconds, p.peak_mb);
   phases.push_back(p);
   return ok;
@@ -258,11 +281,12 @@ std::string rate(double count, double seconds) {
 
 void print_table(const std::string& title) {
   std::cout << "\n" << title << "\n";
-  std::cout << fmt::format("  {:<40} {:>9} {:>11} {:>9} {:>8} {:>10} {:>10}\n", "phase", "seconds", "rows/s", "MB/s", "cpu/wall",
-                           "RSS MB", "peak MB");
+  std::cout << fmt::format("  {:<40} {:>9} {:>11} {:>9} {:>8} {:>6} {:>10} {:>10}\n", "phase", "seconds", "rows/s", "MB/s", "cpu/wall",
+                           "sys %", "RSS MB", "peak MB");
   for (const auto& p : phases)
-    std::cout << fmt::format("  {:<40} {:>9.3f} {:>11} {:>9} {:>8.2f} {:>10} {:>10.1f}\n", p.name, p.seconds, rate(p.rows, p.seconds),
+    std::cout << fmt::format("  {:<40} {:>9.3f} {:>11} {:>9} {:>8.2f} {:>6.0f} {:>10} {:>10.1f}\n", p.name, p.seconds, rate(p.rows, p.seconds),
                              p.megabytes > 0 ? fmt::format("{:.1f}", p.megabytes / p.seconds) : "", p.seconds > 0 ? p.cpu_seconds / p.seconds : 0.0,
+                             p.cpu_seconds > 0 ? 100 * p.system_seconds / p.cpu_seconds : 0.0,
                              std::isnan(p.resident_mb) ? "" : fmt::format("{:.1f}", p.resident_mb), p.peak_mb);
 }
 
@@ -274,7 +298,8 @@ void print_verdict(const std::string& what, double seconds, double peak_mb) {
 
 // ---- the in-process phases ----------------------------------------------------------------------
 
-struct LibraryTotals {
+// The whole of one path (in-process, or the command line), for the verdict.
+struct PathTotals {
   double seconds = 0;
   double peak_mb = 0;
   bool complete = false;
@@ -314,9 +339,9 @@ void print_estimates(const sidc::LeastSquaresSummary& s) {
   if (!std::exchange(truth_shown, true)) std::cout << "       (true: m=1 c[1]=0.3 c[3]=0.05 s[1]=1 s[3]=0.5 d[2]=0.2, the other 14 are 0)\n";
 }
 
-LibraryTotals run_library(const fs::path& model_path, const fs::path& csv_path, std::size_t rows) {
+PathTotals run_library(const fs::path& model_path, const fs::path& csv_path, std::size_t rows) {
   using namespace sidc;
-  LibraryTotals totals;
+  PathTotals totals;
   std::cout << "\nin-process phases (sidc libraries):\n";
 
   std::optional<ir::Model> model;
@@ -449,7 +474,7 @@ LibraryTotals run_library(const fs::path& model_path, const fs::path& csv_path, 
 
 struct ChildRun {
   int exit_status = -1;
-  double seconds = 0, cpu_seconds = 0, peak_mb = 0;
+  double seconds = 0, cpu_seconds = 0, system_seconds = 0, peak_mb = 0;
 };
 
 // Runs argv in `dir` with stdout and stderr to files; waits with wait4 for the child's rusage.
@@ -475,12 +500,13 @@ std::optional<ChildRun> run_child(const std::vector<std::string>& args, const fs
   r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   r.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   r.cpu_seconds = seconds_of(u.ru_utime) + seconds_of(u.ru_stime);
+  r.system_seconds = seconds_of(u.ru_stime);
   r.peak_mb = static_cast<double>(u.ru_maxrss) * 1024.0 / 1e6;
   return r;
 }
 
-LibraryTotals run_command_line(const fs::path& dir, const std::string& model_name, std::size_t rows, double csv_mb) {
-  LibraryTotals totals;
+PathTotals run_command_line(const fs::path& dir, const std::string& model_name, std::size_t rows, double csv_mb) {
+  PathTotals totals;
   const std::string sidc = SIDC_BINARY;
   std::cout << fmt::format("\ncommand line ({}):\n", sidc);
   auto child = [&](const std::string& name, std::vector<std::string> args, const std::string& log, double count, double mb) {
@@ -491,7 +517,7 @@ LibraryTotals run_command_line(const fs::path& dir, const std::string& model_nam
       return false;
     }
     std::cout << fmt::format("{:8.3f} s   peak {:8.1f} MB   exit {}\n", r->seconds, r->peak_mb, r->exit_status);
-    phases.push_back(Phase{name, r->seconds, count, mb, r->cpu_seconds, NAN, r->peak_mb, true});
+    phases.push_back(Phase{name, r->seconds, count, mb, r->cpu_seconds, r->system_seconds, NAN, r->peak_mb, true});
     totals.seconds += r->seconds;
     totals.peak_mb = std::max(totals.peak_mb, r->peak_mb);
     if (r->exit_status != 0) std::cout << fmt::format("    -> see {}\n", (dir / (log + ".err")).string());
@@ -524,6 +550,7 @@ int main(int argc, char** argv) {
 
   std::cout << fmt::format("fit_bench: {} rows, 20 candidate operations, {} hardware threads, directory {}\n", options->rows,
                            std::thread::hardware_concurrency(), dir.string());
+  std::cout << "  load average at start: " << load_average() << "\n";
   {
     std::ofstream model(model_path);
     model << model_text(csv_name);
@@ -543,7 +570,7 @@ int main(int argc, char** argv) {
   }
   const double csv_mb = static_cast<double>(fs::file_size(csv_path)) / 1e6;
 
-  LibraryTotals library, command_line;
+  PathTotals library, command_line;
   // The children run first, while this process is small: a forked child's peak (from wait4)
   // starts at the resident size it inherits at the fork (Linux counts the copied mapping until
   // exec), so it is measured before the in-process phases grow this process.
@@ -560,7 +587,8 @@ int main(int argc, char** argv) {
     std::cout << "  (total = compile + parse + bind + evaluate + default solve; peak MB is this process's high-water mark so far)\n";
   }
 
-  std::cout << fmt::format("\nverdict ({} rows; targets: whole fit < {:g} s, peak < {:g} MB):\n", options->rows, kTargetSeconds, kTargetPeakMB);
+  std::cout << "\nload average at end: " << load_average() << "\n";
+  std::cout << fmt::format("verdict ({} rows; targets: whole fit < {:g} s, peak < {:g} MB):\n", options->rows, kTargetSeconds, kTargetPeakMB);
   if (library.complete) print_verdict("in-process, CSV to parameters", library.seconds, library.peak_mb);
   else if (options->library) std::cout << "  in-process phases did not complete\n";
   if (command_line.complete) print_verdict("sidc compile && sidc fit, CSV to report", command_line.seconds, command_line.peak_mb);

@@ -1,6 +1,7 @@
 #include "cli/fit_command.hpp"
 
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
@@ -331,6 +332,17 @@ int run_fit(const FitArguments& a) {
   return status;
 }
 
+// CLI11's own range check prints the whole range of a double; say it plainly.
+const CLI::Validator positive = CLI::Validator(
+    [](std::string& value) -> std::string {
+      double x = 0;
+      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
+      if (ec != std::errc() || end != value.data() + value.size() || !(x > 0) || !std::isfinite(x))
+        return "`" + value + "` is not a positive number";
+      return {};
+    },
+    "POSITIVE");
+
 }  // namespace
 
 void add_fit_command(CLI::App& app, int& exit_status) {
@@ -340,9 +352,9 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_option("--data", a->data, "Record(s) to fit instead of the model's data statements (CSV)");
   cmd->add_option("--from", a->from, "Start of the fit window (time)");
   cmd->add_option("--to", a->to, "End of the fit window (time)");
-  cmd->add_option("--every", a->every, "Keep every K-th sample")->check(CLI::PositiveNumber);
-  cmd->add_option("--step", a->step, "Sampling step, for records without a time column")->check(CLI::PositiveNumber);
-  cmd->add_option("--resample", a->resample, "Interpolate the record linearly onto this uniform step")->check(CLI::PositiveNumber);
+  cmd->add_option("--every", a->every, "Keep every K-th sample")->check(positive);
+  cmd->add_option("--step", a->step, "Sampling step, for records without a time column")->check(positive);
+  cmd->add_option("--resample", a->resample, "Interpolate the record linearly onto this uniform step")->check(positive);
   cmd->add_option("--derivative", a->derivative, "Moving-arc operator, e.g. \"savgol(7, 3)\"");
   cmd->add_option("--second-derivative", a->second_derivative, "repeated (eq. 3-1.8) or direct")->check(CLI::IsMember({"repeated", "direct"}));
   cmd->add_option("--edges", a->edges, "drop (the thesis) or shorten")->check(CLI::IsMember({"drop", "shorten"}));

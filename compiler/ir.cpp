@@ -245,6 +245,10 @@ const Signal* Model::signal(const std::string& signal_name) const {
   return nullptr;
 }
 
+Signal* Model::signal(const std::string& signal_name) {
+  return const_cast<Signal*>(static_cast<const Model&>(*this).signal(signal_name));  // one lookup for both
+}
+
 int Model::parameter_index(const std::string& parameter_name) const {
   for (std::size_t i = 0; i < parameters.size(); ++i)
     if (parameters[i].name == parameter_name) return static_cast<int>(i);

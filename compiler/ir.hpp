@@ -178,6 +178,7 @@ struct Model {
   std::vector<Equation> equations;
 
   const Signal* signal(const std::string& name) const;
+  Signal* signal(const std::string& name);
   int parameter_index(const std::string& name) const;  // -1 if absent
 };
 

@@ -131,13 +131,19 @@ struct Lowerer {
     if (name == "pi") return constant_value(Number::real(M_PI));
     if (name == "t" || name == "tau" || name == "t0") {
       if (!context.time || (name != "t" && !context.signals)) return not_allowed(where, name);
-      if (name == "t0") return constant_value(Number(0)).empty() && failed ? Sum{} : ir::factor(make(FactorKind::window_start), 1, where);
+      if (name == "t0") {  // a constant: primes on it are an error
+        if (order > 0) {
+          report(diag::derivative_of_constant(where, name));
+          return {};
+        }
+        return ir::factor(make(FactorKind::window_start), 1, where);
+      }
       Sum s = ir::factor(make(name == "t" ? FactorKind::time : FactorKind::elapsed), 1, where);
       return order == 0 ? s : differentiate(s, order).value_or(Sum{});
     }
-    if (const ir::Signal* s = decl.model.signal(name)) {
+    if (ir::Signal* s = decl.model.signal(name)) {
       if (!context.signals) return not_allowed(where, name);
-      const_cast<ir::Signal*>(s)->used = true;
+      s->used = true;
       return ir::factor(make(FactorKind::signal, name, order), 1, where);
     }
     if (decl.families.count(name)) {
@@ -283,7 +289,7 @@ struct Lowerer {
     const std::string& name = c.callee.name.name;
     const Span where = span(c);
     const int primes = static_cast<int>(c.callee.primes.size());
-    if (const ir::Signal* s = decl.model.signal(name)) return initial_value(c, *s, primes);
+    if (ir::Signal* s = decl.model.signal(name)) return initial_value(c, *s, primes);
     if (!is_function_name(name)) {
       if (decl.names.count(name) || decl.model.parameter_index(name) >= 0 || index_value(name) || is_builtin_name(name)) {
         const char* what = decl.model.parameter_index(name) >= 0 ? "a parameter" : "a constant";
@@ -333,7 +339,7 @@ struct Lowerer {
     return ir::number(Number::real(y), where);
   }
 
-  Sum initial_value(const ast::Call& c, const ir::Signal& s, int order) {
+  Sum initial_value(const ast::Call& c, ir::Signal& s, int order) {
     const Span where = span(c);
     if (c.arguments.size() != 1) {
       report(diag::bad_initial_value(where, s.name));
@@ -356,7 +362,7 @@ struct Lowerer {
       f.at = *n;
     }
     if (!context.signals) return not_allowed(where, s.name);
-    const_cast<ir::Signal&>(s).used = true;
+    s.used = true;
     return ir::factor(std::move(f), 1, where);
   }
 
@@ -516,7 +522,7 @@ LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Di
   if (declarations.equations.empty() && !diagnostics.has_errors())
     diagnostics.add(diag::empty_model(Span{parsed.source, 0, 0}));
   for (const auto& s : declarations.model.signals) {
-    if (s.used || (s.definition && false)) continue;
+    if (s.used) continue;
     if (diagnostics.has_errors()) break;  // an earlier error may be why it looks unused
     diagnostics.add(s.kind == ir::Signal::Kind::output ? diag::output_unused(s.span, s.name) : diag::input_unused(s.span, s.name));
   }

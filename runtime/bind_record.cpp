@@ -67,8 +67,7 @@ std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const 
   if (options.weights) {
     auto values = complete_column(record, *options.weights);
     if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    names.push_back("\x01weights");  // carried through resampling and decimation with the signals
-    columns.push_back(*std::get<const std::vector<double>*>(values));
+    columns.push_back(*std::get<const std::vector<double>*>(values));  // resampled and decimated with the signals
     out.weights_column = *options.weights;
   }
 
@@ -83,10 +82,8 @@ std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const 
   const std::size_t every = static_cast<std::size_t>(std::max(1, options.every));
   out.time = decimate(time, every);
   out.step *= static_cast<double>(every);
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (names[i] == "\x01weights") out.weights = decimate(columns[i], every);
-    else out.signals[names[i]] = decimate(columns[i], every);
-  }
+  for (std::size_t i = 0; i < names.size(); ++i) out.signals[names[i]] = decimate(columns[i], every);
+  if (options.weights) out.weights = decimate(columns.back(), every);  // the one column past the signals
 
   // Inputs given as expressions of t (the thesis' x = 60 sin 4 pi t), evaluated on the grid.
   for (const auto& s : model.signals) {

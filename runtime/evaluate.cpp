@@ -201,6 +201,8 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t)
       double p = x[i];
       if (power == 2) p = p * p;
       else if (power != 1) p = std::pow(p, power);
+      // A term already exactly zero stays zero where a later factor is infinite (x*y^-1 at
+      // x = y = 0 evaluates to 0, not NaN); NaN still spreads, so a missing value is never hidden.
       if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;
     }
   }

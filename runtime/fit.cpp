@@ -109,15 +109,17 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     g.equations = members;
     // Columns: each parameter once; integration constants once per record.
     std::map<std::pair<int, std::size_t>, std::size_t> column_of;  // (parameter, record or 0) -> column
+    auto per_record = [&](int p) {
+      return model.parameters[static_cast<std::size_t>(p)].origin == ir::Parameter::Origin::integration_constant && records.size() > 1;
+    };
     std::set<int> used;
     for (std::size_t e : members)
       for (const auto& p : model.equations[e].terms) used.insert(p.parameter);
     for (int p : used) {
       const auto& parameter = model.parameters[static_cast<std::size_t>(p)];
-      const bool per_record = parameter.origin == ir::Parameter::Origin::integration_constant && records.size() > 1;
-      for (std::size_t r = 0; r < (per_record ? records.size() : 1); ++r) {
-        column_of[{p, per_record ? r : 0}] = g.columns.size();
-        g.columns.push_back(per_record ? fmt::format("{}@{}", parameter.name, r + 1) : parameter.name);
+      for (std::size_t r = 0; r < (per_record(p) ? records.size() : 1); ++r) {
+        column_of[{p, per_record(p) ? r : 0}] = g.columns.size();
+        g.columns.push_back(per_record(p) ? fmt::format("{}@{}", parameter.name, r + 1) : parameter.name);
       }
     }
     std::size_t total_rows = 0;
@@ -134,8 +136,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
         const ir::Equation& eq = model.equations[e];
         for (const auto& p : eq.terms) {
           const auto& parameter = model.parameters[static_cast<std::size_t>(p.parameter)];
-          const bool per_record = parameter.origin == ir::Parameter::Origin::integration_constant && records.size() > 1;
-          const std::size_t column = column_of.at({p.parameter, per_record ? r : 0});
+          const std::size_t column = column_of.at({p.parameter, per_record(p.parameter) ? r : 0});
           auto values = evaluators[r].evaluate_in_window(p.operation, "the operation of `" + parameter.name + "`");
           if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
           const auto& v = std::get<std::vector<double>>(values);

@@ -178,21 +178,55 @@ struct Reader {
   }
 };
 
-ordered model_json(const ir::Model& m, bool with_trees) {
+ordered operations_json(const std::vector<ir::ParameterTerm>& terms, const ir::Model& m) {
+  ordered operations = ordered::array();
+  for (const auto& [index, op] : terms)
+    operations.push_back(ordered{{"parameter", m.parameters[static_cast<std::size_t>(index)].name}, {"operation", sum_json(op)}});
+  return operations;
+}
+
+ordered model_json(const ir::Model& m) {
   ordered equations = ordered::array();
-  for (std::size_t i = 0; i < m.equations.size(); ++i) {
-    const auto& e = m.equations[i];
-    ordered operations = ordered::array();
-    for (const auto& [index, op] : e.terms) {
-      ordered o{{"parameter", m.parameters[static_cast<std::size_t>(index)].name}};
-      if (with_trees) o["operation"] = sum_json(op);
-      else o["operation"] = print(op);
-      operations.push_back(std::move(o));
-    }
+  for (const auto& e : m.equations) {
     ordered eq{{"text", print(e, m)}, {"span", span_json(e.span)}, {"integrations", e.integrations},
                {"constants", e.integration.constants == ir::IntegrationRequest::Constants::initial ? "initial" : "fitted"},
-               {"operations", std::move(operations)}};
-    eq["known"] = with_trees ? sum_json(e.known) : ordered(print(e.known));
+               {"operations", operations_json(e.terms, m)}};
+    eq["known"] = sum_json(e.known);
+    equations.push_back(std::move(eq));
+  }
+  return equations;
+}
+
+ordered plots_json(const ir::Model& m) {
+  ordered plots = ordered::array();
+  for (const auto& p : m.plots)
+    plots.push_back(ordered{{"name", p.name}, {"text", print(p, m)}, {"span", span_json(p.span)}, {"signal", p.signal},
+                            {"order", p.order}, {"operations", operations_json(p.terms, m)}, {"rest", sum_json(p.rest)},
+                            {"truth", p.truth ? sum_json(*p.truth) : ordered(nullptr)}});
+  return plots;
+}
+
+// Equations of the model from their JSON, parameters looked up by name in `m`.
+std::vector<ir::ParameterTerm> read_operations(const json& j, const ir::Model& m, const Reader& r) {
+  std::vector<ir::ParameterTerm> terms;
+  for (const auto& o : j) {
+    const int index = m.parameter_index(o.at("parameter").get<std::string>());
+    if (index < 0) throw std::runtime_error("an operation names an undeclared parameter");
+    terms.push_back({index, r.sum(o.at("operation"))});
+  }
+  return terms;
+}
+
+std::vector<ir::Equation> read_equations(const json& j, const ir::Model& m, const Reader& r) {
+  std::vector<ir::Equation> equations;
+  for (const auto& e : j) {
+    ir::Equation eq;
+    eq.span = r.span(e.at("span"));
+    eq.integrations = e.at("integrations").get<int>();
+    eq.integration.constants = one_of(e, "constants", {"fitted", "initial"}) == "initial" ? ir::IntegrationRequest::Constants::initial
+                                                                                           : ir::IntegrationRequest::Constants::fitted;
+    eq.terms = read_operations(e.at("operations"), m, r);
+    eq.known = r.sum(e.at("known"));
     equations.push_back(std::move(eq));
   }
   return equations;
@@ -231,11 +265,15 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
   for (const auto& d : m.data) {
     ordered bindings = ordered::object();
     for (const auto& [signal, column] : d.bindings) bindings[signal] = column;
-    data.push_back(ordered{{"path", d.path}, {"bindings", std::move(bindings)}});
+    ordered exact = ordered::array();
+    for (const auto& x : d.exact_derivatives) exact.push_back(ordered{{"signal", x.signal}, {"order", x.order}, {"column", x.column}});
+    data.push_back(ordered{{"path", d.path}, {"bindings", std::move(bindings)}, {"exact_derivatives", std::move(exact)}});
   }
   j["data"] = std::move(data);
-  j["normalized"] = model_json(c.normalized, false);
-  j["equations"] = model_json(m, true);
+  j["weights_expression"] = m.weights ? ordered{{"expression", sum_json(m.weights->value)}, {"span", span_json(m.weights->span)}} : ordered(nullptr);
+  j["plots"] = plots_json(m);
+  j["normalized"] = model_json(c.normalized);
+  j["equations"] = model_json(m);
   return j;
 }
 
@@ -287,22 +325,38 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       ir::DataSource source;
       source.path = d.at("path").get<std::string>();
       for (const auto& [signal, column] : d.at("bindings").items()) source.bindings.emplace_back(signal, column.get<std::string>());
+      for (const auto& x : d.at("exact_derivatives")) {
+        const std::string signal = x.at("signal").get<std::string>();
+        if (!r.signals.count(signal)) throw std::runtime_error("an exact derivative names the undeclared signal `" + signal + "`");
+        const int order = x.at("order").get<int>();
+        if (order < 1) throw std::runtime_error("an exact derivative of order below 1");
+        source.exact_derivatives.push_back({signal, order, x.at("column").get<std::string>(), {}});
+      }
       m.data.push_back(std::move(source));
     }
-    for (const auto& e : j.at("equations")) {
-      ir::Equation eq;
-      eq.span = r.span(e.at("span"));
-      eq.integrations = e.at("integrations").get<int>();
-      eq.integration.constants = one_of(e, "constants", {"fitted", "initial"}) == "initial" ? ir::IntegrationRequest::Constants::initial
-                                                                                             : ir::IntegrationRequest::Constants::fitted;
-      for (const auto& o : e.at("operations")) {
-        const int index = m.parameter_index(o.at("parameter").get<std::string>());
-        if (index < 0) throw std::runtime_error("an operation names an undeclared parameter");
-        eq.terms.push_back({index, r.sum(o.at("operation"))});
-      }
-      eq.known = r.sum(e.at("known"));
-      m.equations.push_back(std::move(eq));
+    if (!j.at("weights_expression").is_null())
+      m.weights = ir::WeightExpression{r.sum(j.at("weights_expression").at("expression")), r.span(j.at("weights_expression").at("span"))};
+    // The derivative form before integration (what `sidc simulate` solves) shares everything but
+    // the equations and the integration constants, which follow the model's own parameters.
+    ir::Model normalized = m;
+    std::erase_if(normalized.parameters, [](const ir::Parameter& p) { return p.origin == ir::Parameter::Origin::integration_constant; });
+    for (const auto& p : j.at("plots")) {
+      ir::PlotFunction plot;
+      plot.name = p.at("name").get<std::string>();
+      plot.span = r.span(p.at("span"));
+      plot.signal = p.at("signal").get<std::string>();
+      if (!r.signals.count(plot.signal)) throw std::runtime_error("a plot names the undeclared signal `" + plot.signal + "`");
+      plot.order = p.at("order").get<int>();
+      plot.terms = read_operations(p.at("operations"), normalized, r);
+      plot.rest = r.sum(p.at("rest"));
+      if (!p.at("truth").is_null()) plot.truth = r.sum(p.at("truth"));
+      normalized.plots.push_back(std::move(plot));
     }
+    // Plots name the model's own parameters, whose indices are the same in both forms.
+    m.plots = normalized.plots;
+    normalized.equations = read_equations(j.at("normalized"), normalized, r);
+    m.equations = read_equations(j.at("equations"), m, r);
+    c.normalized = std::move(normalized);
     return c;
   } catch (const std::exception& ex) {
     error = fmt::format("error: `{}` is not a valid compiled model ({}); compile the model again with `sidc compile`", path, ex.what());

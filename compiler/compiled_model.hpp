@@ -17,11 +17,11 @@
 
 namespace sidc {
 
-inline constexpr int kCompiledModelVersion = 1;
+inline constexpr int kCompiledModelVersion = 2;
 
 struct CompiledModel {
   std::shared_ptr<const SourceFile> source;
-  ir::Model normalized;
+  ir::Model normalized;  // the derivative form (eq. 2-1.2): what `sidc simulate` solves
   ir::Model integrated;  // what is fitted
 };
 

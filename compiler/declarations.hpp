@@ -35,6 +35,10 @@ struct Declarations {
     ir::IntegrationRequest integration;  // from the `integrate`/`constants` settings before it
   };
   std::vector<PendingEquation> equations;
+
+  const ast::Expression* weights = nullptr;  // `set weights = <expression>`
+  Span weights_span;
+  std::vector<const ast::PlotStatement*> plots;
 };
 
 // Names no model may declare: the time variables, pi, the functions and the operators.

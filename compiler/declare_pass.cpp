@@ -109,13 +109,22 @@ struct Declarer {
     source.span = span(d);
     for (const auto& b : d.bindings) {
       const Span where = span(b);
-      const auto already = std::find_if(source.bindings.begin(), source.bindings.end(),
-                                        [&](const auto& x) { return x.first == b.signal.name; });
-      if (already != source.bindings.end()) {
-        diagnostics.add(diag::binding_repeated(where, b.signal.name));
+      const std::string& name = b.signal.name.name;
+      if (!b.signal.primes.empty()) {  // an exact derivative, recorded for comparison
+        const int order = static_cast<int>(b.signal.primes.size());
+        const auto already = std::find_if(source.exact_derivatives.begin(), source.exact_derivatives.end(),
+                                          [&](const auto& x) { return x.signal == name && x.order == order; });
+        if (already != source.exact_derivatives.end()) diagnostics.add(diag::binding_repeated(where, name + b.signal.primes));
+        else source.exact_derivatives.push_back({name, order, b.column, where});
         continue;
       }
-      source.bindings.emplace_back(b.signal.name, b.column);
+      const auto already = std::find_if(source.bindings.begin(), source.bindings.end(),
+                                        [&](const auto& x) { return x.first == name; });
+      if (already != source.bindings.end()) {
+        diagnostics.add(diag::binding_repeated(where, name));
+        continue;
+      }
+      source.bindings.emplace_back(name, b.column);
       source.binding_spans.push_back(where);
     }
     out.model.data.push_back(std::move(source));
@@ -157,6 +166,27 @@ struct Declarer {
     out.model.settings.values[key] = {s.value, value_span};
   }
 
+  // The column form is an ordinary setting (its text quoted, as `set weights = "w"` reads); the
+  // expression form is lowered with the equations (lower_pass.cpp).
+  void operator()(const ast::WeightsSetting& s) {
+    const Span where = span(s);
+    if (auto it = set_once.find("weights"); it != set_once.end()) {
+      diagnostics.add(diag::setting_repeated(where, "weights", it->second));
+      return;
+    }
+    set_once.emplace("weights", where);
+    if (const auto* column = boost::get<std::string>(&s.value.get())) {
+      out.model.settings.values["weights"] = {"\"" + *column + "\"", where};
+    } else {
+      out.weights = &boost::get<ast::Expression>(s.value.get());
+      out.weights_span = where;
+    }
+  }
+
+  void operator()(const ast::PlotStatement& p) {
+    if (declare(p.name.name, span(p.name))) out.plots.push_back(&p);
+  }
+
   void operator()(const ast::Equation& e) { out.equations.push_back({&e, current_integration}); }
 };
 
@@ -167,6 +197,15 @@ Declarations declare_pass(const ParseResult& parsed, Diagnostics& diagnostics) {
   for (const auto& statement : parsed.model.statements) boost::apply_visitor(d, statement);
 
   // Bindings name declared signals (or `t`), and not inputs given as expressions.
+  auto signal_names = [&] {
+    std::vector<std::string> names{"t"};
+    for (const auto& x : d.out.model.signals) names.push_back(x.name);
+    return names;
+  };
+  for (auto& source : d.out.model.data)
+    for (const auto& exact : source.exact_derivatives)
+      if (!d.out.model.signal(exact.signal))
+        diagnostics.add(diag::binding_unknown_signal(exact.span, exact.signal, diag::nearest(exact.signal, signal_names())));
   for (auto& source : d.out.model.data) {
     for (std::size_t i = 0; i < source.bindings.size(); ++i) {
       const auto& name = source.bindings[i].first;

@@ -160,11 +160,41 @@ struct Settings {
   std::map<std::string, Value> values;  // key -> raw value, as checked by declare_pass
 };
 
+// An exact derivative recorded beside an output (`y' = "ydot"`): compared with the moving-arc
+// estimate in pictures (Figs. 4-1.8, 4-1.9), never used by the fit.
+struct ExactDerivative {
+  std::string signal;
+  int order = 1;
+  std::string column;
+  Span span;
+};
+
 struct DataSource {
   std::string path;
   std::vector<std::pair<std::string, std::string>> bindings;  // signal (or "t") -> column
   std::vector<Span> binding_spans;
+  std::vector<ExactDerivative> exact_derivatives;
   Span span;
+};
+
+// `set weights = <expression>`: each row's residual weighted by the expression's value on it
+// (eq. 2-1.6). The column form `set weights = "w"` stays a setting (Settings::values).
+struct WeightExpression {
+  Sum value;
+  Span span;
+};
+
+// `plot damper(y') = c1*y' + ... against ...`: a function of one signal built from the model's
+// parameters, value = sum_k a_k * terms[k].operation + rest, drawn with the fitted values over the
+// range the record covers; `truth` (no parameters) is what the user knows it should be.
+struct PlotFunction {
+  std::string name;
+  Span span;
+  std::string signal;  // the argument, and its derivative order
+  int order = 0;
+  std::vector<ParameterTerm> terms;  // in parameter order
+  Sum rest;                          // the parameter-free part
+  std::optional<Sum> truth;
 };
 
 struct Model {
@@ -176,6 +206,8 @@ struct Model {
   Settings settings;
   std::vector<DataSource> data;
   std::vector<Equation> equations;
+  std::optional<WeightExpression> weights;
+  std::vector<PlotFunction> plots;
 
   const Signal* signal(const std::string& name) const;
   Signal* signal(const std::string& name);

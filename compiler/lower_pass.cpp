@@ -51,6 +51,12 @@ struct Context {
   bool time = false;        // equations and input definitions
   const char* what = "";    // for "... must be a number": "a constant", "an index"
   std::string input;        // the input being defined, for its diagnostic
+  std::string known_only;   // "the weights": where a parameter may not stand, for its diagnostic
+  bool new_parameters = true;  // false where only the equations' parameters may be named (plots)
+
+  Context() = default;
+  Context(bool parameters_, bool signals_, bool time_, const char* what_, std::string input_, std::string known_only_ = {})
+      : parameters(parameters_), signals(signals_), time(time_), what(what_), input(std::move(input_)), known_only(std::move(known_only_)) {}
 };
 
 bool has_parameter(const Sum& s, std::string* name = nullptr) {
@@ -97,6 +103,12 @@ struct Lowerer {
 
   Sum parameter(const std::string& name, const Span& where) {
     int index = decl.model.parameter_index(name);
+    if (index < 0 && !context.new_parameters) {
+      std::vector<std::string> candidates;
+      for (const auto& p : decl.model.parameters) candidates.push_back(p.name);
+      report(diag::unknown_name(where, name, diag::nearest(name, candidates), true));
+      return {};
+    }
     if (index < 0) {  // implicit: no `param` declaration in the file
       decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1});
       index = static_cast<int>(decl.model.parameters.size()) - 1;
@@ -174,6 +186,7 @@ struct Lowerer {
   // A name that exists but may not be used here (a signal in a constant, ...).
   Sum not_allowed(const Span& where, const std::string& name) {
     if (!context.input.empty()) report(diag::input_definition_uses_signal(where, context.input, name));
+    else if (!context.known_only.empty()) report(diag::parameter_not_allowed(where, name, context.known_only));
     else report(diag::not_a_number(where, context.what));
     return {};
   }
@@ -497,6 +510,105 @@ struct Lowerer {
   }
 };
 
+// Every signal, time or estimated quantity in `s` other than the plot's argument, for its message.
+std::optional<std::pair<std::string, Span>> foreign_quantity(const Sum& s, const std::string& signal, int order) {
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) {
+      switch (f.kind) {
+        case FactorKind::parameter: break;
+        case FactorKind::signal:
+          if (f.name != signal || f.order != order) return std::pair{f.name + std::string(static_cast<std::size_t>(f.order), '\''), t.span};
+          break;
+        case FactorKind::time: return std::pair{std::string("t"), t.span};
+        case FactorKind::elapsed: return std::pair{std::string("tau"), t.span};
+        case FactorKind::window_start: return std::pair{std::string("t0"), t.span};
+        case FactorKind::initial_value: return std::pair{f.name + "(t0)", t.span};
+        case FactorKind::integral: return std::pair{std::string("int(...)"), t.span};
+        case FactorKind::derivative: return std::pair{std::string("der(...)"), t.span};
+        case FactorKind::function:
+        case FactorKind::power:
+          if (auto inner = foreign_quantity(*f.argument, signal, order)) return inner;
+          break;
+        case FactorKind::guard:
+          for (const auto& c : f.conditions) {
+            if (auto inner = foreign_quantity(*c.lhs, signal, order)) return inner;
+            if (auto inner = foreign_quantity(*c.rhs, signal, order)) return inner;
+          }
+          break;
+      }
+    }
+  return std::nullopt;
+}
+
+// `plot name(y') = fitted against truth`: lowered with the equations' parameters only, split
+// into sum_k a_k op_k + rest like an equation (normalize_pass), and checked to depend on its
+// argument alone, so that it can be drawn over that argument's range.
+std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement& p) {
+  const std::string plot = p.name.name;
+  const std::string argument = p.argument.name.name;
+  const int order = static_cast<int>(p.argument.primes.size());
+  const Span where = l.span(p);
+  const ir::Signal* signal = l.decl.model.signal(argument);
+  if (!signal) {
+    std::vector<std::string> candidates;
+    for (const auto& x : l.decl.model.signals) candidates.push_back(x.name);
+    l.diagnostics.add(diag::plot_argument_not_signal(l.span(p.argument), plot, argument, diag::nearest(argument, candidates)));
+    return std::nullopt;
+  }
+  Context fitted_context{true, true, true, "", {}};
+  fitted_context.new_parameters = false;
+  auto fitted = l.lower_in(p.fitted, fitted_context);
+  std::optional<Sum> truth;
+  if (p.truth) {
+    const std::string owner = fmt::format("the truth of plot `{}`", plot);
+    truth = l.lower_in(*p.truth, Context{false, true, true, "", {}, owner});
+    if (!truth) return std::nullopt;
+  }
+  if (!fitted) return std::nullopt;
+  const std::string shown = argument + std::string(static_cast<std::size_t>(order), '\'');
+  for (const Sum* s : {&*fitted, truth ? &*truth : nullptr}) {
+    if (!s) continue;
+    if (auto other = foreign_quantity(*s, argument, order)) {
+      l.diagnostics.add(diag::plot_uses_other_quantity(other->second.known() ? other->second : where, plot, other->first, shown));
+      return std::nullopt;
+    }
+  }
+  ir::PlotFunction out;
+  out.name = plot;
+  out.span = where;
+  out.signal = argument;
+  out.order = order;
+  out.truth = std::move(truth);
+  std::map<int, std::vector<Term>> operations;
+  std::vector<Term> rest;
+  for (const auto& t : fitted->terms) {
+    int parameter = -1;
+    Term op{t.coefficient, {}, t.span};
+    for (const auto& [f, power] : t.factors) {
+      if (f.kind != FactorKind::parameter) {
+        op.factors.push_back({f, power});
+        continue;
+      }
+      if (power != 1 || parameter >= 0) {
+        l.diagnostics.add(diag::nonlinear_parameter(t.span, f.name, power != 1 ? fmt::format("it is raised to the power {}", power)
+                                                                                : std::string("it multiplies another parameter")));
+        return std::nullopt;
+      }
+      parameter = f.order;
+    }
+    if (parameter < 0) rest.push_back(ir::canonical(std::move(op)));
+    else operations[parameter].push_back(ir::canonical(std::move(op)));
+  }
+  for (auto& [parameter, terms] : operations) out.terms.push_back({parameter, ir::canonical(std::move(terms))});
+  std::erase_if(out.terms, [](const ir::ParameterTerm& x) { return x.operation.empty(); });
+  out.rest = ir::canonical(std::move(rest));
+  if (out.terms.empty()) {
+    l.diagnostics.add(diag::plot_without_parameter(where, plot));
+    return std::nullopt;
+  }
+  return out;
+}
+
 }  // namespace
 
 LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Diagnostics& diagnostics) {
@@ -526,6 +638,14 @@ LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Di
     if (diagnostics.has_errors()) break;  // an earlier error may be why it looks unused
     diagnostics.add(s.kind == ir::Signal::Kind::output ? diag::output_unused(s.span, s.name) : diag::input_unused(s.span, s.name));
   }
+  // After the unused-signal check: a signal that only weights or a plot name is still unused.
+  if (declarations.weights) {
+    Context weights{false, true, true, "the weights", {}, "the weights"};
+    if (auto value = l.lower_in(*declarations.weights, weights))
+      declarations.model.weights = ir::WeightExpression{std::move(*value), declarations.weights_span};
+  }
+  for (const ast::PlotStatement* p : declarations.plots)
+    if (auto plot = lower_plot(l, *p)) declarations.model.plots.push_back(std::move(*plot));
   out.model = std::move(declarations.model);
   out.model.constants = std::move(l.constants);
   return out;

@@ -126,9 +126,12 @@ std::string print(const ir::Sum& s) {
   return out;
 }
 
-std::string print(const ir::Equation& e, const ir::Model& m) {
+namespace {
+
+// sum_k a_k * op_k, each parameter folded into its operation where that reads naturally.
+std::string print_parameter_terms(const std::vector<ir::ParameterTerm>& terms, const ir::Model& m) {
   std::string lhs;
-  for (const auto& [index, operation] : e.terms) {
+  for (const auto& [index, operation] : terms) {
     const auto& name = m.parameters[static_cast<std::size_t>(index)].name;
     ir::Factor p{ir::FactorKind::parameter, name, index, {}, {}, {}, {}};
     std::string text;
@@ -143,7 +146,19 @@ std::string print(const ir::Equation& e, const ir::Model& m) {
     if (lhs.empty()) lhs = negative ? "-" + text : text;
     else lhs += (negative ? " - " : " + ") + text;
   }
-  return lhs + " = " + print(e.known);
+  return lhs;
+}
+
+}  // namespace
+
+std::string print(const ir::Equation& e, const ir::Model& m) { return print_parameter_terms(e.terms, m) + " = " + print(e.known); }
+
+std::string print(const ir::PlotFunction& p, const ir::Model& m) {
+  std::string out = fmt::format("plot {}({}{}) = {}", p.name, p.signal, std::string(static_cast<std::size_t>(p.order), '\''),
+                                print_parameter_terms(p.terms, m));
+  if (!p.rest.empty()) out += " + (" + print(p.rest) + ")";
+  if (p.truth) out += " against " + print(*p.truth);
+  return out;
 }
 
 std::string print_wrapped(const ir::Equation& e, const ir::Model& m, std::size_t width, std::size_t indent) {
@@ -185,9 +200,12 @@ std::string print(const ir::Model& m) {
   for (const auto& d : m.data) {
     std::string bindings;
     for (const auto& [signal, column] : d.bindings) bindings += fmt::format("{}{} = \"{}\"", bindings.empty() ? "" : ", ", signal, column);
+    for (const auto& x : d.exact_derivatives)
+      bindings += fmt::format("{}{}{} = \"{}\"", bindings.empty() ? "" : ", ", x.signal, std::string(static_cast<std::size_t>(x.order), '\''), x.column);
     out += fmt::format("data \"{}\"{}\n", d.path, bindings.empty() ? "" : " (" + bindings + ")");
   }
   for (const auto& [key, value] : m.settings.values) out += fmt::format("set {} = {}\n", key, value.text);
+  if (m.weights) out += "set weights = " + print(m.weights->value) + "\n";
   // `integrate` and `constants` apply to the equations after them: print them where they change.
   ir::IntegrationRequest current;
   for (const auto& e : m.equations) {
@@ -199,6 +217,7 @@ std::string print(const ir::Model& m) {
     current = r;
     out += wrap(print(e, m)) + "\n";
   }
+  for (const auto& p : m.plots) out += wrap(print(p, m)) + "\n";
   return out;
 }
 

@@ -16,6 +16,8 @@ std::string print(const ir::Term& t);
 std::string print(const ir::Factor& f);
 // `a1*y'' + a2*y'*y = x`
 std::string print(const ir::Equation& e, const ir::Model& m);
+// `plot name(y') = ... against ...`, parseable.
+std::string print(const ir::PlotFunction& p, const ir::Model& m);
 // An equation broken after top-level operators into lines of at most `width` characters, the
 // continuation lines indented by `indent` more spaces than the first (which is not indented).
 std::string print_wrapped(const ir::Equation& e, const ir::Model& m, std::size_t width = 100, std::size_t indent = 4);

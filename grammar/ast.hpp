@@ -144,8 +144,10 @@ struct ConstantDeclaration : x3::position_tagged {
 };
 
 // `y = "displacement"` inside a data statement: signal (or `t`) bound to a column by name.
+// `y' = "velocity"` binds an exact derivative of an output, recorded alongside it: never fitted,
+// only compared with the moving-arc estimate (the thesis' Figs. 4-1.8 and 4-1.9).
 struct ColumnBinding : x3::position_tagged {
-  Identifier signal;
+  Variable signal;
   std::string column;
 };
 
@@ -166,6 +168,27 @@ struct Setting : x3::position_tagged {
   std::size_t value_offset = 0;  // byte offset of the value in the source, for diagnostics
 };
 
+// `set weights = "w"` (a record column) or `set weights = 1/(1 + y'^2)` (an expression of the
+// signals and t): the weight of each row's residual, eq. 2-1.6.
+struct WeightsValue : x3::variant<std::string, Expression> {
+  using base_type::base_type;
+  using base_type::operator=;
+};
+
+struct WeightsSetting : x3::position_tagged {
+  WeightsValue value;
+};
+
+// `plot damper(y') = c1*y' + c2*y'^3 against 0.5*y' + y'^3`: a function of one signal made of
+// the model's parameters (the damper force of eq. 4-1.1), drawn over the range the record covers
+// with the fitted values, optionally against a truth the user knows (Figs. 4-1.13, 4-1.14).
+struct PlotStatement : x3::position_tagged {
+  Identifier name;
+  Variable argument;
+  Expression fitted;
+  std::optional<Expression> truth;
+};
+
 // `lhs = rhs`
 struct Equation : x3::position_tagged {
   Expression lhs;
@@ -173,7 +196,7 @@ struct Equation : x3::position_tagged {
 };
 
 struct Statement : x3::variant<ModelName, SignalDeclaration, ParameterDeclaration, ConstantDeclaration,
-                               DataStatement, Setting, Equation> {
+                               DataStatement, WeightsSetting, Setting, PlotStatement, Equation> {
   using base_type::base_type;
   using base_type::operator=;
 };

@@ -27,6 +27,7 @@ BOOST_FUSION_ADAPT_STRUCT(sidc::ast::SignalItem, name, definition)
 BOOST_FUSION_ADAPT_STRUCT(sidc::ast::SignalDeclaration, kind, signals)
 BOOST_FUSION_ADAPT_STRUCT(sidc::ast::ConstantItem, name, value)
 BOOST_FUSION_ADAPT_STRUCT(sidc::ast::ColumnBinding, signal, column)
+BOOST_FUSION_ADAPT_STRUCT(sidc::ast::PlotStatement, name, argument, fitted, truth)
 BOOST_FUSION_ADAPT_STRUCT(sidc::ast::DataStatement, path, bindings)
 BOOST_FUSION_ADAPT_STRUCT(sidc::ast::Equation, lhs, rhs)
 

@@ -88,10 +88,28 @@ struct AstPrinter {
   }
   void operator()(const ast::DataStatement& d) {
     out += fmt::format("(data \"{}\"", d.path);
-    for (const auto& b : d.bindings) out += fmt::format(" {} = \"{}\"", b.signal.name, b.column);
+    for (const auto& b : d.bindings) out += fmt::format(" {}{} = \"{}\"", b.signal.name.name, b.signal.primes, b.column);
     out += ")\n";
   }
   void operator()(const ast::Setting& s) { out += fmt::format("(set {} \"{}\")\n", s.key.name, s.value); }
+  void operator()(const ast::WeightsSetting& s) {
+    if (const auto* column = boost::get<std::string>(&s.value.get())) {
+      out += fmt::format("(set weights (column \"{}\"))\n", *column);
+    } else {
+      out += "(set weights ";
+      (*this)(boost::get<ast::Expression>(s.value.get()));
+      out += ")\n";
+    }
+  }
+  void operator()(const ast::PlotStatement& p) {
+    out += fmt::format("(plot {}({}{}) ", p.name.name, p.argument.name.name, p.argument.primes);
+    (*this)(p.fitted);
+    if (p.truth) {
+      out += " against ";
+      (*this)(*p.truth);
+    }
+    out += ")\n";
+  }
   void operator()(const ast::Equation& e) {
     out += "(= ";
     (*this)(e.lhs);

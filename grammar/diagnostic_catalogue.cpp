@@ -381,6 +381,29 @@ Diagnostic integrate_option_invalid(std::string_view value) {
 Diagnostic no_signal(const Span& where) {
   return error("no-signal", where, "this equation uses no signal", "an equation relates signals, e.g. `a1*y' + a2*y = x`");
 }
+
+Diagnostic parameter_not_allowed(const Span& where, std::string_view name, std::string_view what) {
+  return error("parameter-not-allowed", where, fmt::format("parameter `{}` cannot appear in {}: it must be known before the fit", name, what),
+               "use signals, t, numbers and constants here");
+}
+
+Diagnostic plot_argument_not_signal(const Span& where, std::string_view plot, std::string_view name, std::string_view nearest) {
+  std::string hint = did_you_mean(nearest);
+  if (hint.empty()) hint = "a plotted function is drawn against a declared signal or one of its derivatives, e.g. `plot damper(y') = ...`";
+  return error("plot-argument", where, fmt::format("plot `{}` is drawn against `{}`, which is no signal of the model", plot, name), hint);
+}
+
+Diagnostic plot_uses_other_quantity(const Span& where, std::string_view plot, std::string_view quantity, std::string_view argument) {
+  return error("plot-other-quantity", where,
+               fmt::format("plot `{}` is a function of `{}` alone, but this term uses `{}`", plot, argument, quantity),
+               "a plotted function is drawn over the range of its one argument; make a separate plot for each quantity");
+}
+
+Diagnostic plot_without_parameter(const Span& where, std::string_view plot) {
+  return error("plot-without-parameter", where, fmt::format("plot `{}` uses no parameter of the model, so nothing fitted is drawn", plot),
+               "write the function with the equations' parameters, e.g. `plot damper(y') = c1*y' + c2*y'^3`");
+}
+
 Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record) {
   return error("operation-not-finite", where,
                fmt::format("`{}`{} is not a finite number at t = {} in `{}`", operation, owner.empty() ? "" : fmt::format(" ({})", owner), time, record),
@@ -414,5 +437,46 @@ Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size
                            "(`set from`/`set to`), fewer parameters, or `set edges = shorten`", margin));
 }
 // [end of compiler-owned section]
+
+// ---- simulation (compiler/explicit_form.cpp, runtime/simulate.cpp)
+Diagnostic simulate_integral(const Span& where, std::string_view term) {
+  return error("simulate-integral", where, fmt::format("`{}` cannot be simulated: an integral of the solution is not a state", term),
+               "simulate the derivative form of the model (`set integrate = 0`), which sidc fit keeps as the normalized equations");
+}
+
+Diagnostic simulate_estimated_derivative(const Span& where, std::string_view term) {
+  return error("simulate-estimated-derivative", where,
+               fmt::format("`{}` cannot be simulated: der() is estimated from recorded data, which a simulation does not have", term),
+               "write the derivative with primes (`y''`), or expand it so that it has a symbolic derivative");
+}
+
+Diagnostic highest_derivative_nonlinear(const Span& where, std::string_view derivative, std::string_view how) {
+  return error("highest-derivative-nonlinear", where,
+               fmt::format("the equation cannot be solved for `{}`: it enters {}", derivative, how),
+               "simulation needs every equation linear in its output's highest derivative, as in `m*y'' + c(y') + k(y) = x`");
+}
+
+Diagnostic simulate_static_output(const Span& where, std::string_view output) {
+  return error("simulate-static-output", where, fmt::format("output `{}` has no derivative in the equations: a static model, nothing to simulate", output),
+               "sidc simulate solves differential equations; a static model is evaluated, not simulated");
+}
+
+Diagnostic simulate_equation_count(const Span& where, std::size_t equations, std::size_t outputs) {
+  return error("simulate-equation-count", where,
+               fmt::format("{} equation{} for {} output{}: a simulation needs one equation per output", equations, equations == 1 ? "" : "s",
+                           outputs, outputs == 1 ? "" : "s"),
+               "give each output one equation that contains its highest derivative");
+}
+
+Diagnostic highest_derivatives_unmatched(const Span& where, std::string_view derivatives) {
+  return error("highest-derivatives-unmatched", where,
+               fmt::format("the equations cannot be solved for {}: no equation is left for some of them", derivatives),
+               "each output's highest derivative must appear in its own equation (an equation without any highest derivative is a constraint, not an equation of motion)");
+}
+
+Diagnostic simulate_initial_value_term(const Span& where, std::string_view term) {
+  return error("simulate-initial-value", where, fmt::format("`{}` has no value in this simulation", term),
+               "a value at a time other than t0 needs a record; give one with --data, or write the number");
+}
 
 }  // namespace sidc::diag

@@ -52,6 +52,11 @@ inline constexpr char sum_index[] = "the summation index, as in `sum(k = 1..6, c
 inline constexpr char sum_equals[] = "`=` after the summation index";
 inline constexpr char sum_comma[] = "`,` before the summand";
 inline constexpr char call_parenthesis[] = "`(` after `der` or `int`";
+inline constexpr char weights_value[] = "a quoted column name or an expression, as in `set weights = \"w\"` or `set weights = 1/(1 + y'^2)`";
+inline constexpr char plot_name[] = "a name for the plotted function, as in `plot damper(y') = ...`";
+inline constexpr char plot_parenthesis[] = "`(` and the signal the function is drawn against, as in `plot damper(y')`";
+inline constexpr char plot_argument[] = "the signal the function is drawn against, as in `plot damper(y')`";
+inline constexpr char plot_equals[] = "`=` and the function's expression in the model's parameters";
 }  // namespace expected
 
 // How a message names what it found where no token is.
@@ -121,6 +126,12 @@ Diagnostic static_model_integrated(const Span& where, int times);
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes);
 Diagnostic integrate_option_invalid(std::string_view value);
 Diagnostic no_signal(const Span& where);
+// A parameter where only known quantities may stand (`what`: "the weights", "the truth of plot `f`").
+Diagnostic parameter_not_allowed(const Span& where, std::string_view name, std::string_view what);
+Diagnostic plot_argument_not_signal(const Span& where, std::string_view plot, std::string_view name, std::string_view nearest);
+// A plotted function must depend on its argument alone (`quantity`: another signal, t, an integral ...).
+Diagnostic plot_uses_other_quantity(const Span& where, std::string_view plot, std::string_view quantity, std::string_view argument);
+Diagnostic plot_without_parameter(const Span& where, std::string_view plot);
 // ---- evaluation on data (runtime/), pointing at the model text
 Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record);
 Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);
@@ -129,5 +140,13 @@ Diagnostic no_data_file(const Span& where);
 Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record);
 Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin);
 // [end of compiler-owned section]
+// ---- simulation (compiler/explicit_form.cpp, runtime/simulate.cpp)
+Diagnostic simulate_integral(const Span& where, std::string_view term);
+Diagnostic simulate_estimated_derivative(const Span& where, std::string_view term);
+Diagnostic highest_derivative_nonlinear(const Span& where, std::string_view derivative, std::string_view how);
+Diagnostic simulate_static_output(const Span& where, std::string_view output);
+Diagnostic simulate_equation_count(const Span& where, std::size_t equations, std::size_t outputs);
+Diagnostic highest_derivatives_unmatched(const Span& where, std::string_view derivatives);
+Diagnostic simulate_initial_value_term(const Span& where, std::string_view term);
 
 }  // namespace sidc::diag

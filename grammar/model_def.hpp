@@ -67,7 +67,7 @@ struct name_parser : x3::parser<name_parser> {
   template <typename Iterator>
   static bool is_reserved(Iterator first, Iterator last) {
     static constexpr std::string_view words[] = {"model", "input", "output", "param", "const", "data",
-                                                 "set",   "and",   "sum",    "der",   "int"};
+                                                 "set",   "and",   "sum",    "der",   "int",    "plot"};
     const auto length = static_cast<std::size_t>(last - first);
     if (length < 3 || length > 6) return false;
     const std::string_view word(&*first, length);
@@ -164,7 +164,7 @@ x3::rule<struct constant_items_class, std::vector<ast::ConstantItem>> const cons
 x3::rule<struct constant_declaration_class, ast::ConstantDeclaration> const constant_declaration = "a constant declaration";
 x3::rule<struct constant_declaration_assembled_class, ast::ConstantDeclaration> const constant_declaration_assembled = "a constant declaration";
 x3::rule<struct file_name_class, std::string> const file_name = expected::file_name;
-x3::rule<struct binding_signal_class, ast::Identifier> const binding_signal = expected::binding_signal;
+x3::rule<struct binding_signal_class, ast::Variable> const binding_signal = expected::binding_signal;
 x3::rule<struct binding_equals_class> const binding_equals = expected::binding_equals;
 x3::rule<struct column_name_class, std::string> const column_name = expected::column_name;
 x3::rule<struct column_binding_class, ast::ColumnBinding> const column_binding = expected::binding_signal;
@@ -174,6 +174,14 @@ x3::rule<struct setting_name_class, ast::Identifier> const setting_name = expect
 x3::rule<struct setting_equals_class> const setting_equals = expected::setting_equals;
 x3::rule<struct setting_value_class, boost::iterator_range<iterator_type>> const setting_value = expected::setting_value;
 x3::rule<struct setting_class, ast::Setting> const setting = "a setting";
+x3::rule<struct weights_value_class, ast::WeightsValue> const weights_value = expected::weights_value;
+x3::rule<struct weights_setting_class, ast::WeightsSetting> const weights_setting = "a weights setting";
+x3::rule<struct weights_setting_assembled_class, ast::WeightsSetting> const weights_setting_assembled = "a weights setting";
+x3::rule<struct plot_name_class, ast::Identifier> const plot_name = expected::plot_name;
+x3::rule<struct plot_parenthesis_class> const plot_parenthesis = expected::plot_parenthesis;
+x3::rule<struct plot_argument_class, ast::Variable> const plot_argument = expected::plot_argument;
+x3::rule<struct plot_equals_class> const plot_equals = expected::plot_equals;
+x3::rule<struct plot_statement_class, ast::PlotStatement> const plot_statement = "a plot statement";
 x3::rule<struct setting_assembled_class, ast::Setting> const setting_assembled = "a setting";
 x3::rule<struct equation_equals_class> const equation_equals = expected::equation_equals;
 x3::rule<struct equation_class, ast::Equation> const equation = "an equation";
@@ -245,6 +253,8 @@ auto const assign_setting = [](auto& ctx) {
   result.value.assign(value.begin(), end);
   result.value_offset = x3::get<x3::error_handler_tag>(ctx).get().offset(value.begin());
 };
+
+auto const assign_weights = [](auto& ctx) { x3::_val(ctx).value = std::move(x3::_attr(ctx)); };
 
 // ---- lexical rules -------------------------------------------------------------------------------
 
@@ -332,7 +342,8 @@ auto const constant_items_def = constant_item >> *(lit(',') > constant_item);
 auto const constant_declaration_assembled_def = (keyword("const") > constant_items)[assign_constants];
 
 auto const file_name_def = string_literal;
-auto const binding_signal_def = identifier;
+// `y'` binds an exact derivative recorded with the output (compared, never fitted).
+auto const binding_signal_def = lexeme[identifier >> *char_('\'')];
 auto const binding_equals_def = lit('=');
 // A column named by a plain word may be any word, reserved or not: it names a CSV column.
 auto const column_name_def = string_literal | raw[lexeme[name_start >> *name_char]];
@@ -345,12 +356,23 @@ auto const setting_equals_def = lit('=');
 // The scanner ended the statement at the line's end or `;`; the comment is not part of the value.
 auto const setting_value_def = raw[lexeme[+(char_ - '#')]];
 auto const setting_assembled_def = (keyword("set") > setting_name > setting_equals > setting_value)[assign_setting];
+// `weights` alone takes an expression, so it has its own rule, tried before the generic one.
+auto const weights_value_def = string_literal | expression;
+auto const weights_setting_assembled_def =
+    (keyword("set") >> keyword("weights") > setting_equals > weights_value)[assign_weights];
+
+auto const plot_name_def = identifier;
+auto const plot_parenthesis_def = lit('(');
+auto const plot_argument_def = lexeme[identifier >> *char_('\'')];
+auto const plot_equals_def = lit('=');
+auto const plot_statement_def = keyword("plot") > plot_name > plot_parenthesis > plot_argument > closing_parenthesis >
+                                plot_equals > expression > -(keyword("against") > expression);
 
 auto const equation_equals_def = lit('=');
 auto const equation_def = expression > equation_equals > expression;
 
 auto const statement_def = model_statement | signal_declaration | parameter_declaration | constant_declaration |
-                           data_statement | setting | equation;
+                           data_statement | weights_setting | setting | plot_statement | equation;
 auto const end_of_statement_def = x3::eoi;
 auto const statement_line_def = x3::expect[statement] > end_of_statement;
 
@@ -368,6 +390,7 @@ auto const parameter_item_def = parameter_item_assembled;
 auto const parameter_declaration_def = parameter_declaration_assembled;
 auto const constant_declaration_def = constant_declaration_assembled;
 auto const setting_def = setting_assembled;
+auto const weights_setting_def = weights_setting_assembled;
 
 // (Boost.Preprocessor takes at most 64 arguments per macro call.)
 BOOST_SPIRIT_DEFINE(identifier, number, string_literal, closing_quote, closing_parenthesis, closing_bracket, integer,
@@ -379,13 +402,16 @@ BOOST_SPIRIT_DEFINE(expression, additive_operand, additive_expression, additive_
                     sum_parenthesis, sum_index, sum_equals, sum_comma, sum_over, parenthesised)
 BOOST_SPIRIT_DEFINE(identifier_assembled, number_assembled, builtin_callee_assembled, guard_assembled,
                     expression_assembled, model_statement_assembled, parameter_item_assembled,
-                    parameter_declaration_assembled, constant_declaration_assembled, setting_assembled)
+                    parameter_declaration_assembled, constant_declaration_assembled, setting_assembled,
+                    weights_setting_assembled)
 BOOST_SPIRIT_DEFINE(model_name, model_statement, signal_kind, signal_name, signal_item, signal_items,
                     signal_declaration, parameter_name, family_range, parameter_item, parameter_items,
                     parameter_declaration, constant_name, constant_equals, constant_item, constant_items,
                     constant_declaration, file_name, binding_signal, binding_equals, column_name, column_binding,
                     column_bindings, data_statement, setting_name, setting_equals, setting_value, setting,
                     equation_equals, equation, statement, end_of_statement, statement_line)
+BOOST_SPIRIT_DEFINE(weights_value, weights_setting, plot_name, plot_parenthesis, plot_argument, plot_equals,
+                    plot_statement)
 
 // ---- annotation and error handling -----------------------------------------------------------------
 
@@ -416,8 +442,12 @@ struct parameter_declaration_class : x3::annotate_on_success {};
 struct constant_item_class : x3::annotate_on_success {};
 struct constant_declaration_class : x3::annotate_on_success {};
 struct column_binding_class : x3::annotate_on_success {};
+struct binding_signal_class : x3::annotate_on_success {};
 struct data_statement_class : x3::annotate_on_success {};
 struct setting_class : x3::annotate_on_success {};
+struct weights_setting_class : x3::annotate_on_success {};
+struct plot_argument_class : x3::annotate_on_success {};
+struct plot_statement_class : x3::annotate_on_success {};
 struct equation_class : x3::annotate_on_success {};
 
 // Only the outermost rule handles errors.

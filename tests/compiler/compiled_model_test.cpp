@@ -254,7 +254,7 @@ TEST(CompiledModelSchema, RejectsDocumentsBrokenOnPurpose) {
       {"extra property", [](json& j) { j["comment"] = "hand-edited"; }, "unexpected property \"comment\""},
       {"extra property deep down", [&](json& j) { j[first_factor]["note"] = 1; }, "unexpected property \"note\""},
       {"wrong format", [](json& j) { j["format"] = "sidc-model"; }, "/format: expected \"sidc-compiled-model\""},
-      {"newer version", [](json& j) { j["version"] = 2; }, "/version: expected 1"},
+      {"other version", [](json& j) { j["version"] = 1; }, "/version: expected 2"},
       {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, "matches none of the 10 alternatives"},
       {"zero power", [&](json& j) { j[first_factor]["power"] = 0; }, "/power"},
       {"zero denominator", [](json& j) { j["equations"][0]["known"]["terms"][0]["coefficient"]["den"] = 0; }, "/den: 0 is below"},
@@ -265,8 +265,12 @@ TEST(CompiledModelSchema, RejectsDocumentsBrokenOnPurpose) {
       {"integration constant without its equation", [](json& j) {
          for (auto& p : j["parameters"]) if (p["origin"] == "integration_constant") p["equation"] = -1;
        }, "/parameters/3: matches none of the 2 alternatives of oneOf"},
-      {"tree where the normalized form holds text", [](json& j) { j["normalized"][0]["known"] = j["equations"][0]["known"]; },
-       "/normalized/0/known: expected \"string\""},
+      {"text where the normalized form holds a tree", [](json& j) { j["normalized"][0]["known"] = "x"; },
+       "/normalized/0/known: expected \"object\""},
+      {"plot without operations", [](json& j) {
+         j["plots"] = json::array({{{"name", "f"}, {"text", "plot f(y) = 1"}, {"span", j["signals"][0]["span"]}, {"signal", "y"},
+                                    {"order", 0}, {"operations", json::array()}, {"rest", j["equations"][0]["known"]}, {"truth", nullptr}}});
+       }, "/plots/0/operations"},
   };
   for (const auto& b : breakages) {
     json broken = good;
@@ -344,7 +348,7 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
   const std::vector<Breakage> breakages{
       {"wrong format name", [](json& j) { j["format"] = "something-else"; }, {"m.sidc.json", "not a compiled sidc model"}},
       {"not an object", [](json& j) { j = json::array({1, 2}); }, {"m.sidc.json"}},
-      {"wrong version", [](json& j) { j["version"] = 2; }, {"m.sidc.json", "format 2", "reads format 1"}},
+      {"wrong version", [](json& j) { j["version"] = 1; }, {"m.sidc.json", "format 1", "reads format 2"}},
       {"version not a number", [](json& j) { j["version"] = "1"; }, {"m.sidc.json", "compile the model again"}},
       {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, {"unknown factor kind `spline`"}},
       {"missing field", [](json& j) { j["equations"][0].erase("known"); }, {"m.sidc.json", "known", "compile the model again"}},

@@ -82,11 +82,20 @@ inline std::string text(const ast::Statement& statement) {
     std::string operator()(const ast::DataStatement& d) const {
       std::string out = "data <" + d.path + ">";
       for (std::size_t i = 0; i < d.bindings.size(); ++i)
-        out += (i ? ", " : " (") + d.bindings[i].signal.name + " = <" + d.bindings[i].column + ">";
+        out += (i ? ", " : " (") + d.bindings[i].signal.name.name + d.bindings[i].signal.primes + " = <" +
+               d.bindings[i].column + ">";
       return d.bindings.empty() ? out : out + ")";
     }
     std::string operator()(const ast::Setting& s) const {
       return "set " + s.key.name + " = <" + s.value + ">@" + std::to_string(s.value_offset);
+    }
+    std::string operator()(const ast::WeightsSetting& s) const {
+      if (const auto* column = boost::get<std::string>(&s.value.get())) return "set weights = column <" + *column + ">";
+      return "set weights = " + text(boost::get<ast::Expression>(s.value.get()));
+    }
+    std::string operator()(const ast::PlotStatement& p) const {
+      return "plot " + p.name.name + "(" + p.argument.name.name + p.argument.primes + ") = " + text(p.fitted) +
+             (p.truth ? " against " + text(*p.truth) : std::string());
     }
     std::string operator()(const ast::Equation& e) const { return text(e.lhs) + " = " + text(e.rhs); }
   };

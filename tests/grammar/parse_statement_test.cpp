@@ -80,9 +80,9 @@ TEST(ParseStatement, DataWithQuotedAndPlainColumns) {
   const auto& data = statement_as<ast::DataStatement>(result, 0);
   EXPECT_EQ(data.path, "runs/rec 1.csv");
   ASSERT_EQ(data.bindings.size(), 3u) << result.diagnostics.render_all();
-  EXPECT_EQ(data.bindings[0].signal.name, "t");
+  EXPECT_EQ(data.bindings[0].signal.name.name, "t");
   EXPECT_EQ(data.bindings[0].column, "time (s)");
-  EXPECT_EQ(data.bindings[1].signal.name, "y");
+  EXPECT_EQ(data.bindings[1].signal.name.name, "y");
   EXPECT_EQ(data.bindings[1].column, "displacement");
   // A plain column name may be a reserved word: it names a CSV column, not a model quantity.
   EXPECT_EQ(data.bindings[2].column, "data");
@@ -90,6 +90,36 @@ TEST(ParseStatement, DataWithQuotedAndPlainColumns) {
 
 TEST(ParseStatement, DataBindingsOverSeveralLines) {
   EXPECT_EQ(statement_text("data \"r.csv\" (\n  t = \"time\",\n  y = \"y\"\n)"), "data <r.csv> (t = <time>, y = <y>)");
+}
+
+TEST(ParseStatement, DataBindsAnExactDerivative) {
+  EXPECT_EQ(statement_text("data \"a.csv\" (y = \"y\", y' = \"ydot\", y'' = yddot)"),
+            "data <a.csv> (y = <y>, y' = <ydot>, y'' = <yddot>)");
+}
+
+TEST(ParseStatement, WeightsTakeAColumnOrAnExpression) {
+  EXPECT_EQ(statement_text("set weights = \"w\"  # a column"), "set weights = column <w>");
+  EXPECT_EQ(statement_text("set weights = 1/(1 + y'^2)"), statement_text("set weights = (1/(1 + y'^2))"));
+  const ParseResult result = parse_text("set weights = 1/(1 + y'^2)");
+  const auto& s = statement_as<ast::WeightsSetting>(result, 0);
+  EXPECT_NE(boost::get<ast::Expression>(&s.value.get()), nullptr);
+  // Other settings keep their raw text.
+  EXPECT_EQ(statement_text("set weightsx = 2"), "set weightsx = <2>@15");
+}
+
+TEST(ParseStatement, PlotStatementWithAndWithoutTruth) {
+  const ParseResult result = parse_text("plot damper(y') = c1*y' + c2*y'^3 against 0.5*y'");
+  const auto& p = statement_as<ast::PlotStatement>(result, 0);
+  EXPECT_EQ(p.name.name, "damper");
+  EXPECT_EQ(p.argument.name.name, "y");
+  EXPECT_EQ(p.argument.primes, "'");
+  ASSERT_TRUE(p.truth.has_value());
+  EXPECT_EQ(statement_text("plot spring(y) = k1*y"), "plot spring(y) = (k1 * y)");
+}
+
+TEST(ParseStatement, PlotIsAReservedWord) {
+  const ParseResult result = parse_text("plot*y = x");
+  EXPECT_TRUE(result.diagnostics.has_errors());
 }
 
 TEST(ParseStatement, SettingValueIsTheTrimmedRawText) {

@@ -233,6 +233,17 @@ struct SpanChecker {
     (*this)(n.key);
     EXPECT_EQ(result.source->text.substr(n.value_offset, n.value.size()), n.value);
   }
+  void operator()(const ast::WeightsSetting& n) {
+    check(n, "WeightsSetting");
+    if (const auto* e = boost::get<ast::Expression>(&n.value.get())) (*this)(*e);
+  }
+  void operator()(const ast::PlotStatement& n) {
+    check(n, "PlotStatement");
+    (*this)(n.name);
+    (*this)(n.argument);
+    (*this)(n.fitted);
+    if (n.truth) (*this)(*n.truth);
+  }
   void operator()(const ast::Equation& n) {
     check(n, "Equation");
     (*this)(n.lhs);
@@ -245,10 +256,12 @@ TEST(Span, EveryNodeOfEveryKindHasOne) {
       "model quasi_linear\n"
       "input x = 60*sin(4*pi*t), w\noutput y\n"
       "param m, a[1..24]\nconst g = 9.81, L = -2*g\n"
-      "data \"r.csv\" (t = \"time\", y = disp)\nset integrate = 1 # once\n"
+      "data \"r.csv\" (t = \"time\", y = disp, y' = v)\nset integrate = 1 # once\n"
+      "set weights = 1/(1 + y'^2)\n"
       "m*y'' + sum(k = 1..6, a[k]*y'^k)*[y' <= 0 and y > -2] +\n"
-      "  der(y^3, 1) + int(y) + y'(0) - (y/g)^-1 = x\n");
-  ASSERT_EQ(result.model.statements.size(), 8u) << result.diagnostics.render_all();
+      "  der(y^3, 1) + int(y) + y'(0) - (y/g)^-1 = x\n"
+      "plot damper(y') = a[1]*y' against 2*y'\n");
+  ASSERT_EQ(result.model.statements.size(), 10u) << result.diagnostics.render_all();
   SpanChecker checker{result};
   for (const auto& statement : result.model.statements) boost::apply_visitor(checker, statement.get());
   EXPECT_GT(checker.nodes, 80);

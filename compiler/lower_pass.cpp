@@ -53,6 +53,7 @@ struct Context {
   std::string input;        // the input being defined, for its diagnostic
   std::string known_only;   // "the weights": where a parameter may not stand, for its diagnostic
   bool new_parameters = true;  // false where only the equations' parameters may be named (plots)
+  bool weights = false;        // `set weights = ...`: an unknown word may be a column meant in quotes
 
   Context() = default;
   Context(bool parameters_, bool signals_, bool time_, const char* what_, std::string input_, std::string known_only_ = {})
@@ -179,7 +180,8 @@ struct Lowerer {
       }
       return parameter(name, where);
     }
-    report(diag::unknown_name(where, name, diag::nearest(name, known_names()), decl.parameters_declared));
+    if (context.weights) report(diag::weights_unknown_name(where, name, diag::nearest(name, known_names())));
+    else report(diag::unknown_name(where, name, diag::nearest(name, known_names()), decl.parameters_declared));
     return {};
   }
 
@@ -641,6 +643,7 @@ LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Di
   // After the unused-signal check: a signal that only weights or a plot name is still unused.
   if (declarations.weights) {
     Context weights{false, true, true, "the weights", {}, "the weights"};
+    weights.weights = true;
     if (auto value = l.lower_in(*declarations.weights, weights))
       declarations.model.weights = ir::WeightExpression{std::move(*value), declarations.weights_span};
   }

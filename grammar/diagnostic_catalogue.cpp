@@ -387,6 +387,12 @@ Diagnostic parameter_not_allowed(const Span& where, std::string_view name, std::
                "use signals, t, numbers and constants here");
 }
 
+Diagnostic weights_unknown_name(const Span& where, std::string_view name, std::string_view nearest) {
+  std::string hint = fmt::format("a record column is written in quotes: `set weights = \"{}\"`", name);
+  if (!nearest.empty()) hint = fmt::format("did you mean `{}`? A record column is written in quotes: `set weights = \"{}\"`", nearest, name);
+  return error("weights-unknown-name", where, fmt::format("unknown name `{}` in the weights expression", name), hint);
+}
+
 Diagnostic plot_argument_not_signal(const Span& where, std::string_view plot, std::string_view name, std::string_view nearest) {
   std::string hint = did_you_mean(nearest);
   if (hint.empty()) hint = "a plotted function is drawn against a declared signal or one of its derivatives, e.g. `plot damper(y') = ...`";

@@ -128,6 +128,8 @@ Diagnostic integrate_option_invalid(std::string_view value);
 Diagnostic no_signal(const Span& where);
 // A parameter where only known quantities may stand (`what`: "the weights", "the truth of plot `f`").
 Diagnostic parameter_not_allowed(const Span& where, std::string_view name, std::string_view what);
+// `set weights = w` where `w` is no name of the model: most likely a column meant in quotes.
+Diagnostic weights_unknown_name(const Span& where, std::string_view name, std::string_view nearest);
 Diagnostic plot_argument_not_signal(const Span& where, std::string_view plot, std::string_view name, std::string_view nearest);
 // A plotted function must depend on its argument alone (`quantity`: another signal, t, an integral ...).
 Diagnostic plot_uses_other_quantity(const Span& where, std::string_view plot, std::string_view quantity, std::string_view argument);

@@ -137,7 +137,9 @@ StatementExtent scan_statement(std::string_view text, std::size_t begin) {
       const std::size_t start = i;
       ++i;
       while (i < n && is_name_char(data[i])) ++i;
-      if (i - start == 3 && data[start] == 'a' && data[start + 1] == 'n' && data[start + 2] == 'd') {
+      // `and` (in a guard) and `against` (in a plot statement) join two parts of one statement.
+      const std::string_view word(data + start, i - start);
+      if (word == "and" || word == "against") {
         total -= chain;
         chain = 0;
         previous = Previous::continuation;

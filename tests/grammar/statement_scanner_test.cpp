@@ -31,11 +31,14 @@ TEST(StatementScanner, NewlineOrSemicolonEndsAStatement) {
 }
 
 TEST(StatementScanner, ContinuationTokens) {
-  for (const std::string token : {"+", "-", "*", "/", "^", "(", "[", ",", "=", "<", "<=", ">", ">=", "and"})
+  for (const std::string token : {"+", "-", "*", "/", "^", "(", "[", ",", "=", "<", "<=", ">", ">=", "and", "against"})
     EXPECT_EQ(statements("a " + token + "\n b\nc").size(), 2u) << token;
   EXPECT_EQ(statements("a ..\n b").size(), 2u);
   EXPECT_EQ(statements("a'\n b").size(), 2u);
   EXPECT_EQ(statements("a)\n b").size(), 2u);
+  // Whole words only: a name that merely starts with one is an operand.
+  EXPECT_EQ(statements("a + andy\n b").size(), 2u);
+  EXPECT_EQ(statements("a + againstx\n b").size(), 2u);
 }
 
 TEST(StatementScanner, CommentsAndBlankLinesDoNotBreakAContinuation) {

@@ -29,4 +29,9 @@ struct BindOptions {
 std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const ir::DataSource& source,
                                                     const ir::Model& model, const BindOptions& options);
 
+// The same on a record the caller gives away: the columns used once are moved into the
+// SampledRecord, not copied (the record is left with those columns empty).
+std::variant<SampledRecord, Diagnostic> bind_record(Record&& record, const ir::DataSource& source, const ir::Model& model,
+                                                    const BindOptions& options);
+
 }  // namespace sidc

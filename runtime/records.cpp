@@ -1,10 +1,14 @@
-// CSV reading: one read of the whole file, then one pass over the bytes. The fast path per cell
+// CSV reading: the whole file mapped (read, when it cannot be mapped), then one pass over the
+// bytes, on two threads for large files (the second half from a line start near the middle; see
+// parse_rows_on_two_threads). The fast path per cell
 // reads the number straight off the buffer (read_simple_number, else std::from_chars; both stop
 // at the separator by themselves), so a cell costs one conversion and a comparison; everything
 // unusual (quotes, `+`, `D` exponents, decimal commas, text, NaN) falls to a slow path that
 // looks at the cell's text. Measured on a
 // 10^7-row, 4-column, 426 MB file (2-core VM, -O2): about 28 M values/s and 300 MB/s in CPU
-// time for read_csv, 34 M values/s for parse_csv on text already in memory.
+// time for read_csv, 34 M values/s for parse_csv on text already in memory (one thread; the
+// 10^7-row bench record's figures with two threads are in bench/README.md). A file truncated by
+// another process while it is mapped can end the process with SIGBUS.
 #include "runtime/records.hpp"
 
 #include <algorithm>
@@ -21,6 +25,11 @@
 #include <memory>
 #include <new>
 #include <system_error>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 namespace sidc {
 namespace {
@@ -198,6 +207,8 @@ class CsvParser {
   std::optional<Diagnostic> split_header(const char*& p, std::vector<Field>& fields);
   char detect_separator(const char* p) const;
   std::optional<Diagnostic> parse_rows(const char* p);
+  const char* split_point(const char* p) const;
+  std::optional<Diagnostic> parse_rows_on_two_threads(const char* p, const char* split);
   CellValue slow_cell(const char*& p, std::string& text);
   void reserve_rows(const char* p);
 
@@ -343,7 +354,7 @@ std::optional<Diagnostic> CsvParser::parse_rows(const char* p) {
   auto& columns = record_.columns;
   std::vector<std::size_t> faults_this_row;  // columns that recorded a fault text on this row
   std::string cell_text;
-  std::size_t row = 0;
+  std::size_t row = columns.empty() ? 0 : columns.front().size();  // rows already read (a continued parse)
   int expected_line = 0;
   const char sep = separator_;
   const bool blanks = blank_separated_;
@@ -428,6 +439,65 @@ std::optional<Diagnostic> CsvParser::parse_rows(const char* p) {
   return std::nullopt;
 }
 
+// Where a second thread may start: the first line start after the middle of the rows' text, when
+// that text is at least CsvOptions::parallel_above_bytes long and the machine has a second core.
+const char* CsvParser::split_point(const char* p) const {
+  const auto remaining = static_cast<std::size_t>(end() - p);
+  if (remaining < options_.parallel_above_bytes || remaining < 2 || std::thread::hardware_concurrency() < 2) return nullptr;
+  const char* middle = p + remaining / 2;
+  const void* newline = std::memchr(middle, '\n', static_cast<std::size_t>(end() - middle));
+  if (!newline) return nullptr;  // CR-only line ends: one thread
+  const char* split = static_cast<const char*>(newline) + 1;
+  return split < end() ? split : nullptr;
+}
+
+// The rows before `split` here, the rows from `split` on a second parser on another thread (its
+// line numbers counted from 1 and shifted afterwards), then its rows appended. When the second
+// part has a problem, it is parsed again here, after the first, so that the diagnostic carries
+// the line number of the file; the result is the same as parse_rows(p) in every case.
+std::optional<Diagnostic> CsvParser::parse_rows_on_two_threads(const char* p, const char* split) {
+  const std::string_view whole = text_;
+  CsvParser tail(std::string_view(split, static_cast<std::size_t>(end() - split)), path_, options_);
+  tail.separator_ = separator_;
+  tail.blank_separated_ = blank_separated_;
+  tail.record_.names = record_.names;
+  tail.record_.columns.resize(record_.columns.size());
+  tail.record_.first_faults.resize(record_.first_faults.size());
+  tail.reserve_rows(split);
+  std::optional<Diagnostic> tail_error;
+  std::thread second([&] { tail_error = tail.parse_rows(split); });
+  text_ = std::string_view(whole.data(), static_cast<std::size_t>(split - whole.data()));
+  std::optional<Diagnostic> head_error = parse_rows(p);
+  second.join();
+  text_ = whole;
+  if (head_error) return head_error;
+  if (tail_error) return parse_rows(split);  // line_ is where the first part ended: the file's numbering
+  const std::size_t head_rows = record_.rows();
+  const int line_offset = line_ - 1;  // tail line 1 is file line line_
+  for (std::size_t j = 0; j < record_.columns.size(); ++j) {
+    auto& column = record_.columns[j];
+    column.insert(column.end(), tail.record_.columns[j].begin(), tail.record_.columns[j].end());
+    tail.record_.columns[j] = {};
+    auto& kept = record_.first_faults[j];
+    for (auto& fault : tail.record_.first_faults[j]) {
+      if (kept.size() >= kFaultsKeptPerColumn) break;
+      fault.row += head_rows;
+      kept.push_back(std::move(fault));
+    }
+  }
+  for (const auto& [row, line] : tail.record_.line_jumps) {
+    const std::size_t shifted_row = row + head_rows;
+    const int shifted_line = line + line_offset;
+    // The tail's first row always starts a jump of its own; keep it only when it is one.
+    if (shifted_row > 0 && record_.line_of_original_row(shifted_row - 1) + 1 == shifted_line &&
+        !record_.line_jumps.empty() && row == 0)
+      continue;
+    record_.line_jumps.emplace_back(shifted_row, shifted_line);
+  }
+  line_ += tail.line_ - 1;
+  return std::nullopt;
+}
+
 std::variant<Record, Diagnostic> CsvParser::run() {
   if (std::string why; !options_.is_valid(&why)) return data_diag::invalid_csv_options(why);
   record_.path = path_;
@@ -489,7 +559,11 @@ std::variant<Record, Diagnostic> CsvParser::run() {
   }
 
   reserve_rows(p);
-  if (auto error = parse_rows(p)) return *error;
+  if (const char* split = split_point(p)) {
+    if (auto error = parse_rows_on_two_threads(p, split)) return *error;
+  } else if (auto error = parse_rows(p)) {
+    return *error;
+  }
   if (record_.rows() == 0) return data_diag::no_data_rows(path_, record_.header_line);
   for (auto& column : record_.columns) column.shrink_to_fit();
   return std::move(record_);
@@ -559,6 +633,24 @@ std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOpti
   }
   if (status.type() == std::filesystem::file_type::directory) return data_diag::is_directory(path);
 
+  // A regular file is mapped, not read: the parser works on the page cache itself, with no copy
+  // and no fresh buffer to fault in (a tenth of the time of a 400 MB record).
+  if (status.type() == std::filesystem::file_type::regular) {
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec && size > 0) {
+      const int fd = ::open(path.c_str(), O_RDONLY);
+      if (fd >= 0) {
+        void* mapped = ::mmap(nullptr, static_cast<std::size_t>(size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+        ::close(fd);
+        if (mapped != MAP_FAILED) {
+          ::madvise(mapped, static_cast<std::size_t>(size), MADV_SEQUENTIAL);
+          auto result = parse_csv(std::string_view(static_cast<const char*>(mapped), static_cast<std::size_t>(size)), path, options);
+          ::munmap(mapped, static_cast<std::size_t>(size));
+          return result;
+        }
+      }
+    }
+  }
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!file) return data_diag::cannot_open(path, std::generic_category().message(errno));
   // One read of the whole file into an uninitialised buffer (zeroing 400 MB first costs a tenth of

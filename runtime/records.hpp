@@ -82,11 +82,14 @@ struct CsvOptions {
   enum class Header { detect, present, absent } header = Header::detect;
   bool decimal_comma = false;  // read `1,5` as 1.5; only with ';', '\t' or ' ' separators
   char comment = '#';          // a line whose first non-blank character is this is skipped; 0 = none
+  // Rows' text at least this long is parsed on two threads (each half from a line start); the
+  // record and every diagnostic are the same as on one thread. SIZE_MAX: always one thread.
+  std::size_t parallel_above_bytes = std::size_t{8} << 20;
 
   bool is_valid(std::string* why = nullptr) const;
 };
 
-// Reads a whole file with one read and parses it in memory.
+// Maps (or, when it cannot be mapped, reads) a whole file and parses it in memory.
 std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOptions& options = {});
 
 // The same, on text already in memory; `path` is only used in diagnostics.

@@ -85,6 +85,91 @@ bool TriangularAccumulator::add_rows(const Eigen::MatrixXd& block, const Eigen::
   return true;
 }
 
+Eigen::Block<Eigen::MatrixXd> TriangularAccumulator::rows_area(Index m) {
+  const Index width = p_ + 1;
+  if (work_.rows() < width + m || work_.cols() != width) work_.resize(width + std::max<Index>(m, 0), width);
+  return work_.block(width, 0, std::max<Index>(m, 0), width);
+}
+
+// Row totals of one block, combined with the running ones: the same quantities note_row keeps,
+// per block with Chan et al.'s pairwise formula instead of per row with Welford's.
+void TriangularAccumulator::note_block(const Eigen::Ref<const Eigen::MatrixXd>& rows, const double* weights) {
+  const Index m = rows.rows();
+  const auto b = rows.col(p_);
+  std::size_t counted = 0;
+  bool any_zero_weight = false;
+  if (weights)
+    for (Index i = 0; i < m; ++i) any_zero_weight |= weights[i] == 0;
+  if (!any_zero_weight) {
+    if (m == 0) return;
+    for (Index j = 0; j < p_; ++j) {
+      const auto column = static_cast<std::size_t>(j);
+      if (rows_ == 0) column_value_[column] = rows(0, j);
+      if (column_constant_[column] && !(rows.col(j).array() == column_value_[column]).all()) column_constant_[column] = 0;
+    }
+    counted = static_cast<std::size_t>(m);
+  } else {
+    for (Index i = 0; i < m; ++i) {
+      if (weights[i] == 0) continue;
+      for (Index j = 0; j < p_; ++j) {
+        const auto column = static_cast<std::size_t>(j);
+        if (rows_ == 0 && counted == 0) column_value_[column] = rows(i, j);
+        else if (rows(i, j) != column_value_[column]) column_constant_[column] = 0;
+      }
+      ++counted;
+    }
+  }
+  // Weighted moments of b with weights v = w^2: the block's own in double (two passes, so the
+  // centred sum has no cancellation), then merged into the running long-double totals.
+  double sum_v = static_cast<double>(m), block_mean = 0, block_centred = 0, sum_vyy = 0;
+  if (!weights) {
+    if (m > 0) block_mean = b.mean();
+    block_centred = (b.array() - block_mean).square().sum();
+    sum_vyy = b.squaredNorm();
+  } else {
+    const Eigen::ArrayXd v = Eigen::Map<const Eigen::ArrayXd>(weights, m).square();
+    sum_v = v.sum();
+    if (sum_v > 0) block_mean = (v * b.array()).sum() / sum_v;
+    block_centred = (v * (b.array() - block_mean).square()).sum();
+    sum_vyy = (v * b.array().square()).sum();
+  }
+  if (sum_v > 0) {
+    const long double total = weight_sum_ + sum_v;
+    const long double delta = block_mean - mean_;
+    centred_squares_ += block_centred + delta * delta * weight_sum_ * sum_v / total;
+    mean_ += delta * sum_v / total;
+    weight_sum_ = total;
+  }
+  uncentred_squares_ += sum_vyy;
+  rows_ += counted;
+}
+
+bool TriangularAccumulator::fold_rows_area(Index m, const double* weights, std::string* why) {
+  const auto reject = [&](std::string text) {
+    ++rejected_blocks_;
+    if (first_rejection_.empty()) first_rejection_ = text;
+    if (why) *why = std::move(text);
+    return false;
+  };
+  const Index width = p_ + 1;
+  if (m < 0 || work_.rows() < width + m || work_.cols() != width) return reject("fold_rows_area without a rows_area of that size");
+  auto rows = work_.block(width, 0, m, width);
+  if (!rows.leftCols(p_).allFinite()) return reject("block has a NaN or infinite entry");
+  if (!rows.col(p_).allFinite()) return reject("right-hand side has a NaN or infinite entry");
+  if (weights) {
+    const Eigen::Map<const Eigen::VectorXd> w(weights, m);
+    if (!(w.allFinite() && (w.array() >= 0).all())) return reject("weights must be finite and >= 0");
+  }
+  note_block(rows, weights);
+  if (weights) rows = Eigen::Map<const Eigen::VectorXd>(weights, m).asDiagonal() * rows;
+  // QR of the stacked [T; rows] in place: its R is the new T.
+  work_.topRows(width) = triangle_;
+  Eigen::Ref<Eigen::MatrixXd> stacked = work_.topRows(width + m);
+  const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(stacked);
+  triangle_ = stacked.topRows(width).triangularView<Eigen::Upper>();
+  return true;
+}
+
 bool TriangularAccumulator::merge(const TriangularAccumulator& other, std::string* why) {
   if (other.p_ != p_) {
     if (why) *why = fmt::format("cannot merge an accumulator of {} columns into one of {}", other.p_, p_);

@@ -42,6 +42,15 @@ class TriangularAccumulator {
   bool add_rows(const Eigen::MatrixXd& block, const Eigen::VectorXd& rhs, const Eigen::VectorXd* weights,
                 std::string* why = nullptr);
 
+  // The fast path for a producer that can write rows in place (runtime/fit.cpp's streamed fit):
+  // rows_area(m) is an m x (p + 1) area [A b] to fill, column-major, valid until the next call;
+  // fold_rows_area(m, weights) then folds those m rows, after multiplying row i by weights[i]
+  // when weights are given (eq. 2-1.6), with the same checks and the same guarantees as add_rows
+  // but without copying the rows: the area is the lower part of the QR's own work matrix
+  // [T; rows], and the row totals are taken per block (Chan's combination, as merge does).
+  Eigen::Block<Eigen::MatrixXd> rows_area(Eigen::Index m);
+  bool fold_rows_area(Eigen::Index m, const double* weights, std::string* why = nullptr);
+
   // Adds the rows another accumulator has seen (same p). Returns false when p differs.
   bool merge(const TriangularAccumulator& other, std::string* why = nullptr);
 
@@ -62,8 +71,11 @@ class TriangularAccumulator {
   void fold(const Eigen::MatrixXd& weighted_rows);  // rows of [diag(w) A, diag(w) b]
   void note_row(const Eigen::MatrixXd& block, const Eigen::VectorXd& rhs, Eigen::Index i, double weight);
 
+  void note_block(const Eigen::Ref<const Eigen::MatrixXd>& rows, const double* weights);
+
   int p_;
-  Eigen::MatrixXd triangle_;  // (p+1) x (p+1), upper triangular
+  Eigen::MatrixXd triangle_;
+  Eigen::MatrixXd work_;  // rows_area's work matrix: (p + 1 + capacity) x (p + 1)  // (p+1) x (p+1), upper triangular
   std::size_t rows_ = 0;
   std::size_t rejected_blocks_ = 0;
   std::string first_rejection_;

@@ -343,3 +343,64 @@ TEST(Records, LongLineIsRefusedWithoutFloodingTheMessage) {
 
 }  // namespace
 }  // namespace sidc
+
+namespace sidc {
+namespace {
+
+// Rows' text of a few hundred kB with comments, blank lines, CRLF and faulty cells in both halves.
+std::string mixed_rows(std::size_t rows) {
+  std::string text = "# a comment before the header\nt,x,y\n";
+  std::mt19937 random(7);
+  for (std::size_t k = 0; k < rows; ++k) {
+    if (k % 997 == 13) text += "# a comment line\n";
+    if (k % 1231 == 5) text += "\n";
+    std::string y = std::to_string(std::uniform_real_distribution<double>(-1, 1)(random));
+    if (k == 100 || k == rows - 100) y = "n/a";  // a fault in each half
+    if (k == rows / 2 + 7) y = "";
+    text += std::to_string(0.001 * static_cast<double>(k)) + "," + std::to_string(k) + "," + y + (k % 3 == 0 ? "\r\n" : "\n");
+  }
+  return text;
+}
+
+TEST(Records, TwoThreadsGiveTheSameRecordAsOne) {
+  const std::string text = mixed_rows(20000);
+  CsvOptions one, two;
+  one.parallel_above_bytes = SIZE_MAX;
+  two.parallel_above_bytes = 1;
+  const Record a = parsed(text, one), b = parsed(text, two);
+  ASSERT_EQ(a.rows(), 20000u);
+  ASSERT_EQ(a.names, b.names);
+  ASSERT_EQ(a.rows(), b.rows());
+  for (std::size_t j = 0; j < a.columns.size(); ++j) {
+    for (std::size_t i = 0; i < a.rows(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(a.columns[j][i]), std::bit_cast<std::uint64_t>(b.columns[j][i])) << j << " " << i;
+    ASSERT_EQ(a.first_faults[j].size(), b.first_faults[j].size());
+    for (std::size_t k = 0; k < a.first_faults[j].size(); ++k) {
+      EXPECT_EQ(a.first_faults[j][k].row, b.first_faults[j][k].row);
+      EXPECT_EQ(a.first_faults[j][k].text, b.first_faults[j][k].text);
+    }
+  }
+  EXPECT_EQ(a.first_faults[2].size(), 3u);
+  for (std::size_t i = 0; i < a.rows(); ++i) ASSERT_EQ(a.line_of_row(i), b.line_of_row(i)) << i;
+  EXPECT_EQ(a.line_jumps, b.line_jumps);
+}
+
+TEST(Records, TwoThreadsReportTheSameLineForARaggedRow) {
+  CsvOptions one, two;
+  one.parallel_above_bytes = SIZE_MAX;
+  two.parallel_above_bytes = 1;
+  std::string text = mixed_rows(5000);
+  const std::size_t late = text.find('\n', text.size() * 3 / 4);
+  text.insert(late, ",9");  // a row with a fourth field, in the second half
+  const std::string expected = render(failed(text, one));
+  EXPECT_NE(expected.find("field"), std::string::npos) << expected;
+  EXPECT_EQ(render(failed(text, two)), expected);
+  const std::size_t early = text.find('\n', text.size() / 4);
+  text.insert(early, ",9");  // and one in the first half: that one is reported
+  const std::string first = render(failed(text, one));
+  EXPECT_NE(first, expected);
+  EXPECT_EQ(render(failed(text, two)), first);
+}
+
+}  // namespace
+}  // namespace sidc

@@ -1,0 +1,336 @@
+// The streamed fit (FitOptions::stream_above_entries, runtime/block_evaluator.hpp,
+// TriangularAccumulator::rows_area) against the dense one on problems where both run: the thesis'
+// section 4-1 models (guards, an input defined in the model, the integrated form with its
+// integration constants), several records, every other sample, row weights, and the section 4-2
+// process model (two groups, initial values y2(0)). Blocks are made small (a few rows) so that
+// every problem is cut into many blocks on two threads; the two paths must agree to rounding.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "compiler/pipeline.hpp"
+#include "runtime/bind_record.hpp"
+#include "runtime/block_evaluator.hpp"
+#include "runtime/fit.hpp"
+
+namespace sidc {
+namespace {
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+ir::Model compiled_text(const std::string& name, const std::string& text) {
+  const auto r = compile(std::make_shared<const SourceFile>(name, text), {});
+  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
+  return r.ok() ? *r.integrated : ir::Model{};
+}
+
+ir::Model compiled_file(const std::string& path) { return compiled_text(path, read(path)); }
+
+SampledRecord appendix_a(const ir::Model& model, int every = 1) {
+  auto record = read_csv(SIDC_SOURCE_DIR "/examples/thesis-4-1/appendix_a.csv");
+  EXPECT_TRUE(std::holds_alternative<Record>(record));
+  ir::DataSource source;
+  source.bindings = {{"t", "t"}, {"y", "y"}};
+  BindOptions bind;
+  bind.every = every;
+  auto bound = bind_record(std::get<Record>(record), source, model, bind);
+  EXPECT_TRUE(std::holds_alternative<SampledRecord>(bound)) << render(std::get<Diagnostic>(bound));
+  return std::get<SampledRecord>(std::move(bound));
+}
+
+FitOptions thesis_options() {
+  FitOptions o;
+  o.to = 0.82;  // the models' `set to`
+  return o;
+}
+
+FitOptions streamed(FitOptions o, std::size_t block_rows = 7, int threads = 2) {
+  o.stream_above_entries = 0;
+  o.stream_block_rows = block_rows;
+  o.stream_threads = threads;
+  return o;
+}
+
+FitSummary fitted(const ir::Model& m, const std::vector<SampledRecord>& records, const FitOptions& o) {
+  auto result = fit(m, records, o);
+  EXPECT_TRUE(std::holds_alternative<FitSummary>(result)) << render(std::get<Diagnostic>(result));
+  return std::holds_alternative<FitSummary>(result) ? std::get<FitSummary>(result) : FitSummary{};
+}
+
+// Estimates, G(a), standard errors, n, rank, regions, records: the same to rounding.
+void expect_same_fit(const FitSummary& dense, const FitSummary& stream) {
+  ASSERT_EQ(dense.groups.size(), stream.groups.size());
+  for (std::size_t gi = 0; gi < dense.groups.size(); ++gi) {
+    const GroupFit& d = dense.groups[gi];
+    const GroupFit& s = stream.groups[gi];
+    EXPECT_TRUE(d.streamed.empty());
+    EXPECT_FALSE(s.streamed.empty());
+    EXPECT_TRUE(s.row_time.empty() && s.known.empty() && s.summary.residuals.empty());
+    EXPECT_EQ(d.columns, s.columns);
+    EXPECT_EQ(d.summary.n, s.summary.n);
+    EXPECT_EQ(d.summary.rank, s.summary.rank);
+    EXPECT_EQ(d.summary.termination, s.summary.termination);
+    EXPECT_EQ(d.weighted, s.weighted);
+    ASSERT_EQ(d.regions.size(), s.regions.size());
+    for (std::size_t k = 0; k < d.regions.size(); ++k) {
+      EXPECT_EQ(d.regions[k].guards, s.regions[k].guards);
+      EXPECT_EQ(d.regions[k].rows, s.regions[k].rows);
+    }
+    ASSERT_EQ(d.records.size(), s.records.size());
+    for (std::size_t k = 0; k < d.records.size(); ++k) {
+      EXPECT_EQ(d.records[k].rows, s.records[k].rows);
+      EXPECT_EQ(d.records[k].t0, s.records[k].t0);
+    }
+    EXPECT_NEAR(d.summary.G, s.summary.G, 1e-8 * d.summary.G) << "group " << gi;
+    EXPECT_EQ(d.summary.r_squared_centred, s.summary.r_squared_centred);
+    EXPECT_NEAR(d.summary.r_squared, s.summary.r_squared, 1e-9 + 1e-6 * (1 - d.summary.r_squared)) << "group " << gi;
+    EXPECT_NEAR(d.summary.aic, s.summary.aic, 1e-6 * std::abs(d.summary.aic)) << "group " << gi;
+    ASSERT_EQ(d.summary.parameters.size(), s.summary.parameters.size());
+    for (std::size_t k = 0; k < d.summary.parameters.size(); ++k) {
+      const auto& a = d.summary.parameters[k];
+      const auto& b = s.summary.parameters[k];
+      EXPECT_EQ(a.name, b.name);
+      // Rounding of the data is amplified by the condition number (about 10^6 for the thesis'
+      // polynomials after scaling); a thousandth of a standard error is far below any meaning.
+      EXPECT_NEAR(a.value, b.value, 1e-9 * std::abs(a.value) + 1e-6 * a.standard_error) << a.name;
+      EXPECT_NEAR(a.standard_error, b.standard_error, 1e-6 * a.standard_error) << a.name;
+    }
+  }
+}
+
+TEST(StreamedFit, DerivativeFormWithGuardsAndADefinedInput) {
+  const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/derivative_form.sid");
+  const std::vector<SampledRecord> records{appendix_a(m)};
+  const FitSummary dense = fitted(m, records, thesis_options());
+  ASSERT_FALSE(dense.groups.empty());
+  EXPECT_FALSE(dense.groups[0].regions.empty());
+  for (std::size_t block : {1, 7, 64, 4096}) {
+    SCOPED_TRACE(block);
+    expect_same_fit(dense, fitted(m, records, streamed(thesis_options(), block)));
+  }
+  // One thread, and more threads than blocks.
+  expect_same_fit(dense, fitted(m, records, streamed(thesis_options(), 7, 1)));
+  expect_same_fit(dense, fitted(m, records, streamed(thesis_options(), 5, 8)));
+}
+
+TEST(StreamedFit, IntegratedFormSeveralRecordsAndEveryOtherSample) {
+  const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
+  // The Delta = 0.010 record and its every-other-sample Delta = 0.020 version: two records, each
+  // with its own integration constant.
+  const std::vector<SampledRecord> records{appendix_a(m), appendix_a(m, 2)};
+  const FitSummary dense = fitted(m, records, thesis_options());
+  ASSERT_FALSE(dense.groups.empty());
+  EXPECT_EQ(dense.groups[0].records.size(), 2u);
+  expect_same_fit(dense, fitted(m, records, streamed(thesis_options())));
+  // And each alone (every = 2 alone).
+  expect_same_fit(fitted(m, {records[1]}, thesis_options()), fitted(m, {records[1]}, streamed(thesis_options(), 3)));
+}
+
+TEST(StreamedFit, RowWeightsIncludingZeros) {
+  const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
+  SampledRecord r = appendix_a(m);
+  r.weights.resize(r.time.size());
+  for (std::size_t k = 0; k < r.weights.size(); ++k) r.weights[k] = k % 5 == 0 ? 0.0 : 1.0 + 0.5 * std::sin(0.3 * static_cast<double>(k));
+  const FitSummary dense = fitted(m, {r}, thesis_options());
+  ASSERT_FALSE(dense.groups.empty());
+  EXPECT_TRUE(dense.groups[0].weighted);
+  expect_same_fit(dense, fitted(m, {r}, streamed(thesis_options())));
+}
+
+TEST(StreamedFit, TwoGroupsAndInitialValues) {
+  // Section 4-2's model (two equations sharing no parameter, y2(0) in the operations) on a
+  // record made here: a damped response to a square-ish input.
+  const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-2/process.sid");
+  SampledRecord r;
+  r.path = "synthetic";
+  r.step = 0.75;
+  for (int k = 0; k < 300; ++k) {
+    const double t = 0.75 * k;
+    r.time.push_back(t);
+    r.signals["x"].push_back(std::sin(0.05 * t) > 0 ? 1.0 : -0.5);
+    r.signals["y1"].push_back(std::exp(-0.01 * t) * std::sin(0.11 * t) + 0.01 * std::cos(1.3 * t));
+    r.signals["y2"].push_back(0.4 + std::cos(0.07 * t) - 0.02 * std::sin(2.1 * t));
+  }
+  const FitSummary dense = fitted(m, {r}, {});
+  ASSERT_EQ(dense.groups.size(), 2u);
+  expect_same_fit(dense, fitted(m, {r}, streamed({}, 16)));
+}
+
+TEST(StreamedFit, ResidualsInASecondPassMatchTheDenseOnes) {
+  const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
+  const std::vector<SampledRecord> records{appendix_a(m), appendix_a(m, 2)};
+  const FitOptions dense_options = thesis_options(), stream_options = streamed(thesis_options(), 6);
+  const FitSummary dense = fitted(m, records, dense_options);
+  const FitSummary stream = fitted(m, records, stream_options);
+  std::vector<ResidualRow> a, b;
+  ASSERT_FALSE(for_each_residual_block(m, records, dense_options, dense, 0,
+                                       [&](std::span<const ResidualRow> rows) { a.insert(a.end(), rows.begin(), rows.end()); }));
+  ASSERT_FALSE(for_each_residual_block(m, records, stream_options, stream, 0,
+                                       [&](std::span<const ResidualRow> rows) { b.insert(b.end(), rows.begin(), rows.end()); }));
+  ASSERT_EQ(a.size(), dense.groups[0].row_time.size());
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0;
+  for (const auto& row : a) largest = std::max(largest, std::abs(row.residual));
+  ASSERT_GT(largest, 0);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].equation, b[i].equation);
+    EXPECT_EQ(a[i].record, b[i].record);
+    EXPECT_EQ(a[i].time, b[i].time);
+    EXPECT_DOUBLE_EQ(a[i].known, b[i].known);
+    EXPECT_NEAR(a[i].residual, b[i].residual, 1e-7 * largest) << "row " << i;
+  }
+}
+
+TEST(StreamedFit, TheSameDiagnosticForAValueThatIsNotFinite) {
+  // log(y) is NaN where y < 0: both paths must blame the same term at the same time.
+  const ir::Model m = compiled_text("log.sid", "input x\noutput y\nparam a, b\nset to = 0.82\na*y' + b*log(y + 1) = x\n");
+  SampledRecord r = appendix_a(m);
+  for (double& y : r.signals["y"]) y -= 0.8;  // y + 1 < 0 somewhere inside the window
+  const auto dense = fit(m, {r}, thesis_options());
+  const auto stream = fit(m, {r}, streamed(thesis_options(), 3));
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(dense));
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(stream));
+  EXPECT_EQ(render(std::get<Diagnostic>(dense)), render(std::get<Diagnostic>(stream)));
+  EXPECT_NE(render(std::get<Diagnostic>(dense)).find("log"), std::string::npos) << render(std::get<Diagnostic>(dense));
+}
+
+TEST(BlockEvaluator, BlocksGiveTheWholeRecordsValuesBitForBit) {
+  // Every operation of the integrated thesis model, with `shorten` edges too: the block values
+  // equal Evaluator's on the whole record (odd powers here are y^1, y^3, y^5: std::pow against a
+  // product ladder may differ in the last place, so compare those to 4 ulp).
+  for (const auto edges : {DerivativeOptions::Edges::drop, DerivativeOptions::Edges::shorten}) {
+    const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
+    const SampledRecord r = appendix_a(m);
+    EvaluationOptions options;
+    options.derivative.edges = edges;
+    auto window = fit_window(r, m, options, std::nullopt, 0.82);
+    ASSERT_TRUE(std::holds_alternative<FitWindow>(window));
+    const FitWindow w = std::get<FitWindow>(window);
+    Evaluator whole(r, m, options, w);
+    std::vector<const ir::Sum*> sums;
+    for (const auto& p : m.equations[0].terms) sums.push_back(&p.operation);
+    sums.push_back(&m.equations[0].known);
+    auto prepared = prepare_whole_window_values(r, m, options, w, sums);
+    ASSERT_TRUE(std::holds_alternative<WholeWindowValues>(prepared));
+    BlockEvaluator blocks(r, options, w, std::get<WholeWindowValues>(prepared));
+    for (const ir::Sum* s : sums) {
+      auto expected = whole.evaluate_in_window(*s, "test");
+      ASSERT_TRUE(std::holds_alternative<std::vector<double>>(expected));
+      const auto& e = std::get<std::vector<double>>(expected);
+      std::vector<double> got(e.size());
+      for (std::size_t start = 0; start < w.size(); start += 5) {
+        const std::size_t m_rows = std::min<std::size_t>(5, w.size() - start);
+        blocks.start_block(w.first + start, w.first + start + m_rows);
+        auto status = blocks.evaluate(*s, std::span<double>(got.data() + start, m_rows));
+        ASSERT_FALSE(std::holds_alternative<Diagnostic>(status));
+      }
+      for (std::size_t i = 0; i < e.size(); ++i) EXPECT_NEAR(got[i], e[i], 4 * std::numeric_limits<double>::epsilon() * std::abs(e[i])) << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sidc
+
+namespace sidc {
+namespace {
+
+// y = sin(2t + 0.3) + 0.3 sin(3.1t), x = 0.5 y' + 2 y + a little structured misfit, so that the
+// weights change the estimates.
+SampledRecord weighted_test_record() {
+  SampledRecord r;
+  r.path = "synthetic";
+  r.step = 1e-3;
+  for (int k = 0; k < 3001; ++k) {
+    const double t = 1e-3 * k;
+    const double y = std::sin(2 * t + 0.3) + 0.3 * std::sin(3.1 * t);
+    const double dy = 2 * std::cos(2 * t + 0.3) + 0.93 * std::cos(3.1 * t);
+    r.time.push_back(t);
+    r.signals["y"].push_back(y);
+    r.signals["x"].push_back(0.5 * dy + 2 * y + 0.05 * y * y * y);
+  }
+  return r;
+}
+
+TEST(WeightsExpression, EqualsTheSameWeightsGivenAsAColumn) {
+  const ir::Model by_expression = compiled_text("w.sid", "input x\noutput y\nparam a1, a2\nset weights = 1 + y^2\na1*y' + a2*y = x\n");
+  const ir::Model plain = compiled_text("p.sid", "input x\noutput y\nparam a1, a2\na1*y' + a2*y = x\n");
+  ASSERT_TRUE(by_expression.weights.has_value());
+  const SampledRecord r = weighted_test_record();
+  SampledRecord with_column = r;
+  for (double y : r.signals.at("y")) with_column.weights.push_back(1 + y * y);
+  const FitSummary expression = fitted(by_expression, {r}, {});
+  const FitSummary column = fitted(plain, {with_column}, {});
+  const FitSummary unweighted = fitted(plain, {r}, {});
+  ASSERT_EQ(expression.groups.size(), 1u);
+  ASSERT_EQ(column.groups.size(), 1u);
+  EXPECT_TRUE(expression.groups[0].weighted);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(expression.groups[0].summary.parameters[k].value, column.groups[0].summary.parameters[k].value);
+    EXPECT_EQ(expression.groups[0].summary.parameters[k].standard_error, column.groups[0].summary.parameters[k].standard_error);
+    // The weights matter: the unweighted fit differs.
+    EXPECT_NE(expression.groups[0].summary.parameters[k].value, unweighted.groups[0].summary.parameters[k].value);
+  }
+  EXPECT_EQ(expression.groups[0].summary.G, column.groups[0].summary.G);
+  EXPECT_NE(expression.full_report(by_expression).find("weighted by `y^2 + 1`"), std::string::npos)
+      << expression.full_report(by_expression);
+  // And streamed.
+  expect_same_fit(expression, fitted(by_expression, {r}, streamed({}, 100)));
+  expect_same_fit(column, fitted(plain, {with_column}, streamed({}, 100)));
+}
+
+TEST(WeightsExpression, ANegativeWeightIsAnErrorAtTheExpression) {
+  const std::string text = "input x\noutput y\nparam a1, a2\nset weights = y\na1*y' + a2*y = x\n";
+  const ir::Model m = compiled_text("neg.sid", text);
+  const SampledRecord r = weighted_test_record();  // y < 0 somewhere
+  const auto dense = fit(m, {r}, {});
+  const auto stream = fit(m, {r}, streamed({}, 64));
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(dense));
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(stream));
+  const std::string message = render(std::get<Diagnostic>(dense));
+  EXPECT_NE(message.find("neg.sid:4:"), std::string::npos) << message;  // the `set weights` line
+  EXPECT_NE(message.find("finite number >= 0"), std::string::npos) << message;
+  EXPECT_EQ(message, render(std::get<Diagnostic>(stream)));
+}
+
+}  // namespace
+}  // namespace sidc
+
+namespace sidc {
+namespace {
+
+TEST(BindRecord, MovingTheRecordGivesWhatCopyingGives) {
+  const ir::Model m = compiled_text("b.sid", "input x\noutput y\nparam a1, a2\na1*y' + a2*y = x\n");
+  const std::string text = "t,x,y\n0,1,2\n0.1,1.5,2.5\n0.2,1.25,2.75\n0.3,1,3\n0.4,0.5,3.5\n";
+  for (int every : {1, 2}) {
+    auto read = parse_csv(text, "mem.csv");
+    ASSERT_TRUE(std::holds_alternative<Record>(read));
+    const Record record = std::get<Record>(read);
+    ir::DataSource source;
+    BindOptions options;
+    options.every = every;
+    options.weights = "y";  // the column `y` is taken twice: as the signal and as the weights
+    auto copied = bind_record(record, source, m, options);
+    Record given = record;
+    auto moved = bind_record(std::move(given), source, m, options);
+    ASSERT_TRUE(std::holds_alternative<SampledRecord>(copied) && std::holds_alternative<SampledRecord>(moved));
+    const auto& a = std::get<SampledRecord>(copied);
+    const auto& b = std::get<SampledRecord>(moved);
+    EXPECT_EQ(a.time, b.time);
+    EXPECT_EQ(a.step, b.step);
+    EXPECT_EQ(a.signals, b.signals);
+    EXPECT_EQ(a.weights, b.weights);
+    EXPECT_EQ(a.weights, a.signals.at("y"));
+    EXPECT_EQ(a.time.size(), every == 1 ? 5u : 3u);
+  }
+}
+
+}  // namespace
+}  // namespace sidc

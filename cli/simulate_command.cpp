@@ -1,0 +1,315 @@
+// `sidc simulate`: argument parsing and printing only. The model is solved for its highest
+// derivatives by compiler/explicit_form.cpp and integrated by runtime/simulate.cpp.
+//
+// Relies on: cli/fit_command.hpp (loading a model), runtime/bind_record.hpp (a record on its
+// uniform grid). Guarantees: every bad option is a one-line `error:` with a `hint:` and exit code 2
+// (command line) or 1 (model, record, numbers); the CSV has the record's column names (the time
+// column and each output's bound column) and is written atomically; a run that diverges still
+// writes its CSV (NaN after the stop) and exits 1 with the sentence saying where.
+#include "cli/simulate_command.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli/exit_codes.hpp"
+#include "cli/fit_command.hpp"
+#include "cli/read_file.hpp"
+#include "compiler/explicit_form.hpp"
+#include "compiler/settings.hpp"
+#include "runtime/bind_record.hpp"
+#include "runtime/simulate.hpp"
+
+namespace sidc {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SimulateArguments {
+  std::string model;
+  std::string params_file;
+  std::vector<std::string> params, initial;
+  std::string data;
+  std::optional<double> t0, t1, step, tolerance;
+  std::optional<int> every, substeps;
+  std::string method = "rk4", stepper = "dopri5";
+  std::string out;
+};
+
+std::optional<double> parse_number(std::string_view text) {
+  while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+  double x = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), x);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(x)) return std::nullopt;
+  return x;
+}
+
+struct Failure {
+  int code;
+  std::string message;
+};
+
+// name=value pairs; `what` names the option for messages.
+std::variant<std::pair<std::string, double>, Failure> name_value(const std::string& text, const char* option, const char* example) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return Failure{exit_code::usage_error, fmt::format("error: `{} {}` is not NAME=VALUE\nhint: write e.g. `{} {}`", option, text, option, example)};
+  std::string name = text.substr(0, eq);
+  while (!name.empty() && name.back() == ' ') name.pop_back();
+  auto value = parse_number(std::string_view(text).substr(eq + 1));
+  if (!value)
+    return Failure{exit_code::usage_error,
+                   fmt::format("error: `{} {}`: `{}` is not a finite number\nhint: write e.g. `{} {}`", option, text, text.substr(eq + 1), option, example)};
+  return std::pair{name, *value};
+}
+
+std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& model, const SimulateArguments& a) {
+  std::vector<std::optional<double>> values(model.parameters.size());
+  auto assign = [&](const std::string& name, double v, bool from_file) -> std::optional<Failure> {
+    const int index = model.parameter_index(name);
+    if (index < 0) {
+      if (from_file) return std::nullopt;  // an integration constant of an integrated fit: not needed
+      std::string names;
+      for (const auto& p : model.parameters) names += (names.empty() ? "" : ", ") + p.name;
+      return Failure{exit_code::usage_error, fmt::format("error: `--param {}=...`: the model has no parameter `{}`\nhint: its parameters are {}", name, name, names)};
+    }
+    values[static_cast<std::size_t>(index)] = v;
+    return std::nullopt;
+  };
+  if (!a.params_file.empty()) {
+    std::string error;
+    auto text = read_whole_file(a.params_file, error);
+    if (!text) return Failure{exit_code::user_error, error};
+    const auto j = nlohmann::json::parse(*text, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || j.value("format", "") != "sidc-fit" || !j.contains("groups") || !j["groups"].is_array())
+      return Failure{exit_code::user_error, fmt::format("error: `{}` is not a fit.json written by `sidc fit --out`\nhint: run `sidc fit MODEL --out DIR` and pass DIR/fit.json", a.params_file)};
+    for (const auto& g : j["groups"])
+      for (const auto& p : g.value("parameters", nlohmann::json::array()))
+        if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
+          if (auto f = assign(p["name"].get<std::string>(), p["estimate"].get<double>(), true)) return *f;
+  }
+  for (const auto& text : a.params) {
+    auto parsed = name_value(text, "--param", "a1=0.5");
+    if (auto* f = std::get_if<Failure>(&parsed)) return *f;
+    const auto& [name, v] = std::get<std::pair<std::string, double>>(parsed);
+    if (auto f = assign(name, v, false)) return *f;
+  }
+  std::string missing;
+  std::vector<double> out;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!values[i]) missing += (missing.empty() ? "`" : ", `") + model.parameters[i].name + "`";
+    out.push_back(values[i].value_or(0.0));
+  }
+  if (!missing.empty())
+    return Failure{exit_code::usage_error, fmt::format("error: no value for {}\nhint: give every parameter a value with `--param NAME=VALUE`, or pass a fit's `--params fit.json`", missing)};
+  return out;
+}
+
+// "y=1", "y'=0": the output, the derivative order and the value.
+std::variant<std::map<std::string, std::vector<std::optional<double>>>, Failure> given_initial(const ExplicitForm& form,
+                                                                                                const SimulateArguments& a) {
+  std::map<std::string, std::vector<std::optional<double>>> initial;
+  for (const auto& text : a.initial) {
+    auto parsed = name_value(text, "--initial", "\"y'=0\"");
+    if (auto* f = std::get_if<Failure>(&parsed)) return *f;
+    auto [name, v] = std::get<std::pair<std::string, double>>(parsed);
+    int order = 0;
+    while (!name.empty() && name.back() == '\'') name.pop_back(), ++order;
+    const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&](const auto& o) { return o.name == name; });
+    if (out == form.outputs.end())
+      return Failure{exit_code::usage_error, fmt::format("error: `--initial {}`: `{}` is not an output of the model\nhint: initial conditions are for outputs and their derivatives below the highest", text, name)};
+    if (order >= out->order)
+      return Failure{exit_code::usage_error,
+                     fmt::format("error: `--initial {}`: the state of `{}` is its derivatives of order 0 to {}; the equation gives order {}\nhint: drop this initial condition",
+                                 text, name, out->order - 1, out->order)};
+    auto& values = initial[name];
+    values.resize(static_cast<std::size_t>(out->order));
+    values[static_cast<std::size_t>(order)] = v;
+  }
+  return initial;
+}
+
+std::string column_name(const ir::Model& model, const std::string& signal, const std::string& fallback) {
+  for (const auto& d : model.data)
+    for (const auto& [s, column] : d.bindings)
+      if (s == signal) return column;
+  return fallback;
+}
+
+std::string csv_field(const std::string& name) {
+  if (name.find_first_of(",\"\n") == std::string::npos) return name;
+  std::string out = "\"";
+  for (char c : name) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+int run_simulate(const SimulateArguments& a) {
+  auto fail = [](const std::string& message, int code) {
+    std::cerr << message << "\n";
+    return code;
+  };
+  if (a.t0 && a.t1 && !(*a.t1 > *a.t0)) return fail(fmt::format("error: `--t1 {}` is not after `--t0 {}`", *a.t1, *a.t0), exit_code::usage_error);
+  std::string error;
+  auto compiled = load_compiled_model(a.model, error);
+  if (!compiled) return fail(error, exit_code::user_error);
+  const ir::Model& model = compiled->normalized;
+  auto form = explicit_form(model);
+  if (auto* d = std::get_if<Diagnostic>(&form)) return fail(render(*d), exit_code::user_error);
+  const ExplicitForm& explicit_ = std::get<ExplicitForm>(form);
+
+  SimulateOptions o;
+  auto parameters = parameter_values(model, a);
+  if (auto* f = std::get_if<Failure>(&parameters)) return fail(f->message, f->code);
+  o.parameters = std::get<std::vector<double>>(parameters);
+  auto given = given_initial(explicit_, a);
+  if (auto* f = std::get_if<Failure>(&given)) return fail(f->message, f->code);
+  if (a.method == "adaptive") {
+    o.method = SimulateOptions::Method::adaptive;
+    o.stepper = a.stepper == "cash_karp" ? SimulateOptions::Stepper::cash_karp : SimulateOptions::Stepper::dopri5;
+    if (a.tolerance) o.absolute_tolerance = o.relative_tolerance = *a.tolerance;
+    if (a.substeps) return fail("error: `--substeps` is for `--method rk4`\nhint: the adaptive method chooses its own steps; set `--tolerance`", exit_code::usage_error);
+  } else {
+    if (a.tolerance) return fail("error: `--tolerance` is for `--method adaptive`\nhint: the fixed-step method's accuracy is set by `--substeps`", exit_code::usage_error);
+    o.substeps = a.substeps.value_or(1);
+  }
+
+  // The record: --data, else the model's data statement; none is fine with a time grid.
+  std::optional<SampledRecord> record;
+  std::string time_name = column_name(model, "t", "t");
+  ir::DataSource source = model.data.empty() ? ir::DataSource{} : model.data.front();
+  if (!a.data.empty()) source.path = a.data;
+  else if (!model.data.empty() && fs::path(source.path).is_relative())
+    source.path = (fs::path(a.model).parent_path() / source.path).lexically_normal().string();
+  if (!source.path.empty()) {
+    if (a.step) return fail("error: `--step` makes a time grid for a run without a record, but the simulation has one (`--data` or the model's data statement)\nhint: use `--every K` to thin the record", exit_code::usage_error);
+    auto read = read_csv(source.path);
+    if (auto* d = std::get_if<Diagnostic>(&read)) return fail(render(*d), exit_code::user_error);
+    BindOptions bind;
+    const EvaluationSettings e = evaluation_settings(model.settings);
+    bind.every = a.every.value_or(e.every);
+    bind.step = e.step;  // `set step` for a record without a time column
+    auto bound = bind_record(std::get<Record>(read), source, model, bind);
+    if (auto* d = std::get_if<Diagnostic>(&bound)) return fail(render(*d), exit_code::user_error);
+    record = std::get<SampledRecord>(std::move(bound));
+    if (!std::get<Record>(read).column(time_name) && std::get<Record>(read).column("time")) time_name = "time";
+  } else if (a.every) {
+    return fail("error: `--every` thins a record, but the simulation has none\nhint: give one with `--data record.csv`", exit_code::usage_error);
+  }
+
+  std::size_t first = 0;
+  if (record) {
+    const auto& time = record->time;
+    const double from = a.t0.value_or(time.front()), to = a.t1.value_or(time.back());
+    const double tolerance = 1e-9 * std::max(1.0, std::abs(from));
+    first = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), from - tolerance) - time.begin());
+    std::size_t last = first;
+    while (last + 1 < time.size() && time[last + 1] <= to + tolerance) ++last;
+    if (first >= time.size() || last <= first)
+      return fail(fmt::format("error: `{}` has fewer than two samples between t = {} and t = {}\nhint: the record runs from {} to {}", record->path, from, to,
+                              time.front(), time.back()),
+                  exit_code::user_error);
+    o.time.assign(time.begin() + static_cast<std::ptrdiff_t>(first), time.begin() + static_cast<std::ptrdiff_t>(last) + 1);
+    for (const auto& s : model.signals)
+      if (s.kind == ir::Signal::Kind::input && !s.definition)
+        if (auto it = record->signals.find(s.name); it != record->signals.end())
+          o.inputs[s.name].assign(it->second.begin() + static_cast<std::ptrdiff_t>(first), it->second.begin() + static_cast<std::ptrdiff_t>(last) + 1);
+  } else {
+    if (!a.t1 || !a.step)
+      return fail("error: without a record, the time grid needs `--t1` and `--step` (and `--t0`, default 0)\nhint: e.g. `--t1 1 --step 0.01`, or give a record with `--data`", exit_code::usage_error);
+    const double t0 = a.t0.value_or(0.0);
+    if (!(*a.t1 > t0)) return fail(fmt::format("error: `--t1 {}` is not after t0 = {}", *a.t1, t0), exit_code::usage_error);
+    const auto count = static_cast<std::size_t>(std::floor((*a.t1 - t0) / *a.step + 1e-9));
+    if (count > 10'000'000) return fail(fmt::format("error: {} steps of {} from {} to {} is more than 10^7 output rows\nhint: use a larger `--step`", count, *a.step, t0, *a.t1), exit_code::usage_error);
+    for (std::size_t i = 0; i <= count; ++i) o.time.push_back(t0 + static_cast<double>(i) * *a.step);
+    for (const auto& s : model.signals)
+      if (s.kind == ir::Signal::Kind::input && !s.definition)
+        return fail(fmt::format("error: input `{}` has no values: the simulation has no record and the model gives no definition\n"
+                                "hint: give a record with `--data record.csv`, or define it in the model (`input {} = sin(t)`)", s.name, s.name),
+                    exit_code::user_error);
+  }
+  o.t0_for_tau = o.time.front();
+
+  // Initial state: given, else from the record at the first simulated sample, else 0.
+  std::map<std::string, std::vector<double>> from_record;
+  if (record) {
+    EvaluationSettings e = evaluation_settings(model.settings);
+    DerivativeOptions d;
+    d.window = e.derivative.window;
+    d.polyorder = e.derivative.order;
+    auto estimate = initial_state_from_record(explicit_, *record, d, first);
+    if (auto* diag = std::get_if<Diagnostic>(&estimate)) return fail(render(*diag), exit_code::user_error);
+    from_record = std::get<std::map<std::string, std::vector<double>>>(std::move(estimate));
+  }
+  const auto& initial = std::get<std::map<std::string, std::vector<std::optional<double>>>>(given);
+  for (const auto& out : explicit_.outputs) {
+    auto& values = o.initial[out.name];
+    for (int m = 0; m < out.order; ++m) {
+      const auto i = static_cast<std::size_t>(m);
+      if (auto it = initial.find(out.name); it != initial.end() && it->second[i]) values.push_back(*it->second[i]);
+      else if (auto r = from_record.find(out.name); r != from_record.end()) values.push_back(r->second[i]);
+      else values.push_back(0.0);
+    }
+  }
+  if (std::string why; !o.is_valid(&why)) return fail("error: " + why, exit_code::usage_error);
+
+  auto result = simulate(model, explicit_, o);
+  if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
+  const SimulationSummary& summary = std::get<SimulationSummary>(result);
+
+  std::string csv = csv_field(time_name);
+  for (const auto& name : summary.output_names) csv += "," + csv_field(column_name(model, name, name));
+  csv += "\n";
+  for (std::size_t i = 0; i < summary.time.size(); ++i) {
+    csv += fmt::format("{}", summary.time[i]);
+    for (const auto& v : summary.outputs) csv += fmt::format(",{}", v[i]);
+    csv += "\n";
+  }
+  std::string initial_text;
+  for (const auto& out : explicit_.outputs)
+    for (int m = 0; m < out.order; ++m)
+      initial_text += fmt::format("{}{}{} = {}", initial_text.empty() ? "" : ", ", out.name, std::string(static_cast<std::size_t>(m), '\''),
+                                  o.initial[out.name][static_cast<std::size_t>(m)]);
+  const std::string report = fmt::format("sidc simulate: model `{}`, {} ({}), initial state {}\n{}\n", model.name, a.method == "adaptive" ? "adaptive " + a.stepper : "rk4",
+                                         a.method == "adaptive" ? fmt::format("tolerance {}", o.absolute_tolerance) : fmt::format("{} substep{} per sample", o.substeps, o.substeps == 1 ? "" : "s"),
+                                         initial_text, summary.brief_report());
+  if (a.out.empty()) {
+    std::cout << csv;
+    std::cerr << report;
+  } else {
+    if (!write_file_atomically(a.out, csv, error)) return fail(error, exit_code::user_error);
+    std::cout << report << "wrote " << a.out << "\n";
+  }
+  if (!summary.completed()) {
+    std::cerr << "error: " << summary.message << "\nhint: check the parameter values and the initial state; the rows after the stop are NaN\n";
+    return exit_code::user_error;
+  }
+  return exit_code::success;
+}
+
+}  // namespace
+
+void add_simulate_command(CLI::App& app, int& exit_status) {
+  auto a = std::make_shared<SimulateArguments>();
+  CLI::App* cmd = app.add_subcommand("simulate", "Solve a model's equations with given parameter values (thesis section 2-4)");
+  cmd->add_option("model", a->model, "Model file (.sid) or compiled model (.sidc.json)")->required();
+  cmd->add_option("--params", a->params_file, "Parameter values from a fit (DIR/fit.json of `sidc fit --out DIR`)");
+  cmd->add_option("--param", a->params, "Parameter values, NAME=VALUE ... (overrides --params)");
+  cmd->add_option("--data", a->data, "Record giving the time grid, the inputs and the initial state (default: the model's data statement)");
+  cmd->add_option("--every", a->every, "Keep every K-th sample of the record")->check(CLI::PositiveNumber);
+  cmd->add_option("--t0", a->t0, "Start time (default: the record's first sample, or 0)");
+  cmd->add_option("--t1", a->t1, "End time (default: the record's last sample)");
+  cmd->add_option("--step", a->step, "Output step, for a run without a record")->check(CLI::PositiveNumber);
+  cmd->add_option("--initial", a->initial, "Initial conditions, e.g. y=1 \"y'=0\" (default: from the record, else 0)");
+  cmd->add_option("--method", a->method, "rk4 (fixed step, the thesis' solver) or adaptive")->check(CLI::IsMember({"rk4", "adaptive"}));
+  cmd->add_option("--stepper", a->stepper, "For --method adaptive: dopri5 or cash_karp")->check(CLI::IsMember({"dopri5", "cash_karp"}));
+  cmd->add_option("--substeps", a->substeps, "RK4 steps per sample interval (default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--tolerance", a->tolerance, "Absolute and relative tolerance of the adaptive method (default 1e-9)")->check(CLI::PositiveNumber);
+  cmd->add_option("-o,--out", a->out, "Write the simulated outputs to this CSV file (default: stdout)");
+  cmd->callback([a, &exit_status] { exit_status = run_simulate(*a); });
+}
+
+}  // namespace sidc

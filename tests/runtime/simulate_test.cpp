@@ -1,0 +1,277 @@
+// runtime/point_evaluator, runtime/simulate, runtime/validate on problems with known solutions:
+// RK4's order of convergence measured, the adaptive tolerance honoured, a guard switch located,
+// divergence and a vanishing coefficient detected, a coupled multi-output system, validation.
+#include <cmath>
+#include <iostream>
+#include <gtest/gtest.h>
+
+#include "compiler/explicit_form.hpp"
+#include "compiler/pipeline.hpp"
+#include "runtime/point_evaluator.hpp"
+#include "runtime/simulate.hpp"
+#include "runtime/validate.hpp"
+
+namespace sidc {
+namespace {
+
+ir::Model normalized(const std::string& text) {
+  CompileResult r = compile(std::make_shared<const SourceFile>("test.sid", text), {});
+  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
+  return *r.normalized;
+}
+
+ExplicitForm form_of(const ir::Model& m) {
+  auto f = explicit_form(m);
+  EXPECT_TRUE(std::holds_alternative<ExplicitForm>(f)) << render(std::get<Diagnostic>(f));
+  return std::get<ExplicitForm>(f);
+}
+
+std::vector<double> grid(double t0, double t1, double step) {
+  std::vector<double> t;
+  const auto n = static_cast<std::size_t>(std::llround((t1 - t0) / step));
+  for (std::size_t i = 0; i <= n; ++i) t.push_back(t0 + static_cast<double>(i) * step);
+  return t;
+}
+
+SimulationSummary run(const ir::Model& m, const ExplicitForm& f, SimulateOptions o) {
+  auto r = simulate(m, f, o);
+  EXPECT_TRUE(std::holds_alternative<SimulationSummary>(r)) << render(std::get<Diagnostic>(r));
+  return std::get<SimulationSummary>(r);
+}
+
+TEST(PointEvaluator, AgreesWithTheFormulaAndZeroesOffGuards) {
+  const ir::Model m = normalized("input x\noutput y\nparam a, b\na*(sin(y') + 2*y^2*[y <= 1] + exp(t)*tau + (1 + y^2)^0.5) + b*y'*[y > 1] = x\n");
+  PointLayout layout;
+  auto a = compile_point_sum(m.equations[0].terms[0].operation, layout);
+  auto b = compile_point_sum(m.equations[0].terms[1].operation, layout);
+  ASSERT_TRUE(std::holds_alternative<PointSum>(a)) << render(std::get<Diagnostic>(a));
+  ASSERT_TRUE(std::holds_alternative<PointSum>(b));
+  std::vector<double> slots(layout.size());
+  const double y = 0.5, yd = 0.3, t = 0.2, t0 = 0.05;
+  for (std::size_t i = 0; i < layout.size(); ++i) slots[i] = layout.slots()[i].second == 0 ? y : yd;
+  const PointInstant at{slots, t, t0};
+  EXPECT_NEAR(std::get<PointSum>(a).evaluate(at), std::sin(yd) + 2 * y * y + std::exp(t) * (t - t0) + std::sqrt(1 + y * y), 1e-14);
+  // The guard [y > 1] is off: the term is 0 even though y' is not finite.
+  for (std::size_t i = 0; i < layout.size(); ++i)
+    if (layout.slots()[i].second == 1) slots[i] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(std::get<PointSum>(b).evaluate(at), 0.0);
+  ASSERT_EQ(layout.size(), 2u);  // y and y', each once
+}
+
+TEST(PointEvaluator, RefusesIntegrals) {
+  const ir::Model m = normalized("input x\noutput y\nparam a, b\nset integrate = 0\na*y' + b*int(y) = x\n");
+  PointLayout layout;
+  auto b = compile_point_sum(m.equations[0].terms[1].operation, layout);
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(b));
+  EXPECT_EQ(std::get<Diagnostic>(b).code, "simulate-integral");
+}
+
+// y'' + y = cos 2t, y(0) = y'(0) = 0: y = (cos t - cos 2t) / 3.
+const char* kForced = "input x = cos(2*t)\noutput y\nparam a, b\na*y'' + b*y = x\n";
+double forced_exact(double t) { return (std::cos(t) - std::cos(2 * t)) / 3; }
+
+TEST(Simulate, Rk4ConvergesAtFourthOrder) {
+  const ir::Model m = normalized(kForced);
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {1, 1};
+  o.initial["y"] = {0, 0};
+  o.time = grid(0, 10, 0.5);
+  std::vector<double> errors;
+  for (int substeps : {1, 2, 4, 8}) {
+    o.substeps = substeps;
+    const auto s = run(m, f, o);
+    ASSERT_TRUE(s.completed()) << s.message;
+    double e = 0;
+    for (std::size_t i = 0; i < s.time.size(); ++i) e = std::max(e, std::abs(s.outputs[0][i] - forced_exact(s.time[i])));
+    errors.push_back(e);
+  }
+  for (std::size_t i = 1; i < errors.size(); ++i) {
+    const double order = std::log2(errors[i - 1] / errors[i]);
+    std::cout << "rk4, h = " << 0.5 / (1 << i) << ": max error " << errors[i] << ", order " << order << "\n";
+    EXPECT_GT(order, 3.7) << "halving the step from substeps " << (1 << (i - 1)) << ": errors " << errors[i - 1] << " -> " << errors[i];
+    EXPECT_LT(order, 4.5);
+  }
+}
+
+TEST(Simulate, RecordedInputIsInterpolatedToFourthOrder) {
+  // The same input as samples: the cubic interpolation's error is O(H^4) in the sample step H.
+  const ir::Model m = normalized("input x\noutput y\nparam a, b\na*y'' + b*y = x\n");
+  const ExplicitForm f = form_of(m);
+  std::vector<double> errors;
+  for (double step : {0.1, 0.05}) {
+    SimulateOptions o;
+    o.parameters = {1, 1};
+    o.initial["y"] = {0, 0};
+    o.time = grid(0, 10, step);
+    o.substeps = 4;
+    for (double t : o.time) o.inputs["x"].push_back(std::cos(2 * t));
+    const auto s = run(m, f, o);
+    double e = 0;
+    for (std::size_t i = 0; i < s.time.size(); ++i) e = std::max(e, std::abs(s.outputs[0][i] - forced_exact(s.time[i])));
+    errors.push_back(e);
+  }
+  std::cout << "recorded input, sample step 0.1 -> 0.05: max error " << errors[0] << " -> " << errors[1] << ", order "
+            << std::log2(errors[0] / errors[1]) << "\n";
+  EXPECT_GT(std::log2(errors[0] / errors[1]), 3.5) << errors[0] << " -> " << errors[1];
+}
+
+TEST(Simulate, AdaptiveHonoursItsTolerance) {
+  const ir::Model m = normalized(kForced);
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.method = SimulateOptions::Method::adaptive;
+  o.parameters = {1, 1};
+  o.initial["y"] = {0, 0};
+  o.time = grid(0, 10, 0.5);
+  for (auto stepper : {SimulateOptions::Stepper::dopri5, SimulateOptions::Stepper::cash_karp}) {
+    o.stepper = stepper;
+    double previous = 1;
+    for (double tolerance : {1e-5, 1e-8, 1e-11}) {
+      o.absolute_tolerance = o.relative_tolerance = tolerance;
+      const auto s = run(m, f, o);
+      ASSERT_TRUE(s.completed());
+      double e = 0;
+      for (std::size_t i = 0; i < s.time.size(); ++i) e = std::max(e, std::abs(s.outputs[0][i] - forced_exact(s.time[i])));
+      EXPECT_LT(e, 100 * tolerance) << "tolerance " << tolerance;  // global error: local tolerance times a modest growth
+      EXPECT_LT(e, previous);
+      previous = e;
+    }
+  }
+}
+
+// Thesis eq. 4-1.2's damper: c(y') = 0.5 (y' + 0.005 y'^3) for y' <= 0, y' + 0.01 y'^3 for y' > 0.
+const char* kThesis =
+    "input x = 60*sin(4*pi*t)\noutput y\nparam m, cn, cn3, cp, cp3, k, k2\n"
+    "m*y'' + cn*y'*[y' <= 0] + cn3*y'^3*[y' <= 0] + cp*y'*[y' > 0] + cp3*y'^3*[y' > 0] + k*y + k2*y^2 = x\n";
+const std::vector<double> kThesisParameters = {0.051813, 0.5, 0.0025, 1, 0.01, 30, -3};
+
+TEST(Simulate, GuardSwitchesAreLocatedSoRk4KeepsItsOrder) {
+  const ir::Model m = normalized(kThesis);
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = kThesisParameters;
+  o.initial["y"] = {0, 0};
+  o.time = grid(0, 1, 0.01);
+  o.method = SimulateOptions::Method::adaptive;
+  o.absolute_tolerance = o.relative_tolerance = 1e-13;
+  const auto reference = run(m, f, o);
+  ASSERT_TRUE(reference.completed());
+  o.method = SimulateOptions::Method::rk4;
+  auto error = [&](int substeps, bool locate) {
+    o.substeps = substeps;
+    o.locate_switches = locate;
+    const auto s = run(m, f, o);
+    double e = 0;
+    for (std::size_t i = 0; i < s.time.size(); ++i) e = std::max(e, std::abs(s.outputs[0][i] - reference.outputs[0][i]));
+    return std::pair{e, s.switches};
+  };
+  const auto [coarse, switches] = error(2, true);
+  const auto [fine, ignored] = error(4, true);
+  std::cout << "thesis system vs adaptive 1e-13: rk4 h = 0.005 " << coarse << ", h = 0.0025 " << fine << " (order "
+            << std::log2(coarse / fine) << "), " << switches << " switches located\n";
+  EXPECT_GE(switches, 4u);  // y' changes sign four times in the first second (Appendix A)
+  EXPECT_GT(std::log2(coarse / fine), 3.5) << coarse << " -> " << fine;
+  // Without location the step that straddles a kink of the damper costs accuracy.
+  const auto [blind, none] = error(4, false);
+  EXPECT_EQ(none, 0u);
+  std::cout << "without locating the switches, h = 0.0025: " << blind << "\n";
+  EXPECT_LT(fine, blind);
+}
+
+TEST(Simulate, DivergenceIsDetectedWithItsTime) {
+  // y'' = 10 y, y(0) = 1, y'(0) = sqrt(10): y = exp(sqrt(10) t); y' passes 1e8 at t = 5.4625.
+  const ir::Model m = normalized("input x = cos(t)\noutput y\nparam a, b\na*y'' + b*y = 0*x + x - x + 1e-300*x\n");
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {1, -10};
+  o.initial["y"] = {1, std::sqrt(10.0)};
+  o.time = grid(0, 10, 0.01);
+  o.substeps = 4;
+  const auto s = run(m, f, o);
+  EXPECT_EQ(s.status, SimulationSummary::Status::diverged);
+  ASSERT_TRUE(s.stopped_at.has_value());
+  EXPECT_NEAR(*s.stopped_at, std::log(1e8 / std::sqrt(10.0)) / std::sqrt(10.0), 0.02);  // y' = sqrt(10) y passes the bound first
+  EXPECT_NE(s.message.find("diverged"), std::string::npos) << s.message;
+  EXPECT_TRUE(std::isnan(s.outputs[0].back()));
+  EXPECT_TRUE(std::isfinite(s.outputs[0][500]));
+}
+
+TEST(Simulate, VanishingCoefficientIsAnErrorNamingTheTime) {
+  // (1 - t) y'' + y = cos t: the coefficient of y'' vanishes at t = 1.
+  const ir::Model m = normalized("input x = cos(t)\noutput y\nparam a, b, c\na*y'' + b*t*y'' + c*y = x\n");
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {1, -1, 1};
+  o.initial["y"] = {0, 0};
+  o.time = grid(0, 2, 0.01);
+  for (auto method : {SimulateOptions::Method::rk4, SimulateOptions::Method::adaptive}) {
+    o.method = method;
+    const auto s = run(m, f, o);
+    EXPECT_EQ(s.status, SimulationSummary::Status::singular) << s.message;
+    ASSERT_TRUE(s.stopped_at.has_value());
+    EXPECT_NEAR(*s.stopped_at, 1.0, 0.011);
+    EXPECT_NE(s.message.find("coefficient of `y''`"), std::string::npos) << s.message;
+  }
+}
+
+TEST(Simulate, CoupledOutputsSolvedTogether) {
+  // y' + z' = cos t - sin t, y' - z' = cos t + sin t: y = sin t, z = cos t. Each equation holds
+  // both highest derivatives, so the runtime solves a 2 x 2 system at every instant.
+  const ir::Model m = normalized(
+      "input u1 = cos(t) - sin(t), u2 = cos(t) + sin(t)\noutput y, z\nparam a, b, c, d\na*y' + b*z' = u1\nc*y' + d*z' = u2\n");
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {1, 1, 1, -1};
+  o.initial["y"] = {0};
+  o.initial["z"] = {1};
+  o.time = grid(0, 6, 0.1);
+  o.substeps = 2;
+  const auto s = run(m, f, o);
+  ASSERT_TRUE(s.completed()) << s.message;
+  for (std::size_t i = 0; i < s.time.size(); ++i) {
+    EXPECT_NEAR(s.outputs[0][i], std::sin(s.time[i]), 1e-6);
+    EXPECT_NEAR(s.outputs[1][i], std::cos(s.time[i]), 1e-6);
+  }
+}
+
+TEST(Validate, ReproducesItsOwnRecordAndReportsDivergence) {
+  const ir::Model m = normalized(kThesis);
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = kThesisParameters;
+  o.initial["y"] = {0, 0};
+  o.time = grid(0, 1, 0.01);
+  o.substeps = 10;
+  const auto truth = run(m, f, o);
+  SampledRecord record;
+  record.path = "synthetic.csv";
+  record.step = 0.01;
+  record.time = o.time;
+  record.signals["y"] = truth.outputs[0];
+  for (double t : o.time) record.signals["x"].push_back(60 * std::sin(4 * M_PI * t));
+  ValidationOptions v;
+  auto good = validate(m, f, kThesisParameters, record, v);
+  ASSERT_TRUE(std::holds_alternative<ValidationSummary>(good));
+  const auto& g = std::get<ValidationSummary>(good);
+  ASSERT_EQ(g.outputs.size(), 1u);
+  // Started at t = 0.03 from the moving-arc y' (a cubic on exact samples): small, not zero.
+  EXPECT_LT(g.outputs[0].max_abs_error, 2e-3);
+  EXPECT_GT(g.outputs[0].fit_percent, 99.5);
+  EXPECT_NEAR(g.simulation.time.front(), 0.03, 1e-12);
+  // A mass 20% too small: visibly worse.
+  std::vector<double> wrong = kThesisParameters;
+  wrong[0] *= 0.8;
+  const auto bad = std::get<ValidationSummary>(validate(m, f, wrong, record, v));
+  EXPECT_GT(bad.outputs[0].max_abs_error, 10 * g.outputs[0].max_abs_error);
+  EXPECT_NEAR(bad.outputs[0].percent_error, 100 * bad.outputs[0].max_abs_error / 1.8494, 0.5);
+  // A negative spring makes the solution run away: a statement, not an error.
+  std::vector<double> unstable = kThesisParameters;
+  unstable[5] = -3000;
+  const auto runaway = std::get<ValidationSummary>(validate(m, f, unstable, record, v));
+  EXPECT_FALSE(runaway.simulation.completed());
+  EXPECT_NE(runaway.statement.find("could not be solved"), std::string::npos) << runaway.statement;
+}
+
+}  // namespace
+}  // namespace sidc

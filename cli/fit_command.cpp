@@ -16,7 +16,11 @@
 #include "compiler/settings.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
 #include "runtime/bind_record.hpp"
+#include "compiler/explicit_form.hpp"
 #include "runtime/fit.hpp"
+#include "runtime/validate.hpp"
+#include "cli/fit_pictures.hpp"
+#include "cli/record_options.hpp"
 
 namespace sidc {
 namespace {
@@ -25,12 +29,13 @@ namespace fs = std::filesystem;
 
 struct FitArguments {
   std::vector<std::string> compiled;
-  std::vector<std::string> data;
-  std::optional<double> from, to, step, resample;
-  std::optional<int> every;
-  std::string derivative, second_derivative, edges, integration, precision;
+  RecordArguments records;            // --data, --from, --to, --every, ... (record_options.hpp)
   std::string out;
-  std::string weights;
+  bool no_validate = false;
+  std::vector<std::string> validate;  // further records, not used in fitting
+  std::size_t validate_samples = 100000;  // compared at most per record (0 = all)
+  std::string plots;                  // --plots DIR
+  std::string report;                 // --report FILE.html
 };
 
 // The compiled model to fit when none is named: the most recently compiled *.sidc.json in the
@@ -49,7 +54,9 @@ std::optional<std::string> default_compiled_model(std::string& error) {
   return found.back().second;
 }
 
-std::optional<CompiledModel> load_compiled(const std::string& path, std::string& error) {
+}  // namespace
+
+std::optional<CompiledModel> load_compiled_model(const std::string& path, std::string& error) {
   auto text = read_whole_file(path, error);
   if (!text) return std::nullopt;
   if (path.ends_with(".sid")) {  // a model file: compiled here, in memory, nothing written
@@ -79,42 +86,8 @@ std::optional<CompiledModel> load_compiled(const std::string& path, std::string&
   return compiled;
 }
 
-// Settings from the model file, overridden by the command line.
-std::optional<FitOptions> fit_options(const ir::Model& model, const FitArguments& a, std::string& error) {
-  const EvaluationSettings e = evaluation_settings(model.settings);
-  FitOptions o;
-  MovingArc arc = e.derivative;
-  if (!a.derivative.empty()) {
-    auto parsed = parse_moving_arc(a.derivative);
-    if (!parsed) {
-      error = fmt::format("error: `--derivative {}` is not a moving-arc operator\nhint: write e.g. `--derivative \"savgol(7, 3)\"`", a.derivative);
-      return std::nullopt;
-    }
-    arc = *parsed;
-  }
-  o.evaluation.derivative.window = arc.window;
-  o.evaluation.derivative.polyorder = arc.order;
-  bool repeated = e.second_derivative_repeated, shorten = e.shorten_edges, trapezoid = e.trapezoid;
-  if (!a.second_derivative.empty()) repeated = a.second_derivative == "repeated";
-  if (!a.edges.empty()) shorten = a.edges == "shorten";
-  if (!a.integration.empty()) trapezoid = a.integration == "trapezoid";
-  o.evaluation.derivative.second = repeated ? DerivativeOptions::Second::repeated : DerivativeOptions::Second::direct;
-  o.evaluation.derivative.edges = shorten ? DerivativeOptions::Edges::shorten : DerivativeOptions::Edges::drop;
-  o.evaluation.integration.rule = trapezoid ? IntegrationOptions::Rule::trapezoid : IntegrationOptions::Rule::simpson;
-  if (e.smooth_before_integration) {
-    o.evaluation.integration.smoothing_window = e.smooth_before_integration->window;
-    o.evaluation.integration.smoothing_polyorder = e.smooth_before_integration->order;
-  }
-  o.from = a.from ? a.from : e.from;
-  o.to = a.to ? a.to : e.to;
-  if (a.precision == "double") o.least_squares.precision = Precision::double_precision;
-  if (a.precision == "extended") o.least_squares.precision = Precision::extended;
-  if (!o.is_valid(&error)) {
-    error = "error: " + error;
-    return std::nullopt;
-  }
-  return o;
-}
+namespace {
+
 
 nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, const std::string& compiled_path, const FitOptions& o) {
   using nlohmann::ordered_json;
@@ -159,16 +132,112 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
   return j;
 }
 
-std::string residuals_csv(const FitSummary& s) {
-  std::string out = "group,equation,record,t,known,fitted,residual\n";
+// residuals.csv, written as the rows come: a streamed fit evaluates them again block by block
+// (runtime/fit.hpp, for_each_residual_block), so the file never has to be held in memory.
+bool write_residuals(std::ostream& out, const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
+                     const FitSummary& s) {
+  out << "group,equation,record,t,known,fitted,residual\n";
+  fmt::memory_buffer buffer;
   for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
-    const auto& g = s.groups[gi];
-    for (std::size_t i = 0; i < g.row_time.size(); ++i) {
-      const double r = i < g.summary.residuals.size() ? g.summary.residuals[i] : std::numeric_limits<double>::quiet_NaN();
-      out += fmt::format("{},{},{},{},{},{},{}\n", gi + 1, g.row_equation[i] + 1, g.records[g.row_record[i]].path, g.row_time[i], g.known[i],
-                         g.known[i] - r, r);
-    }
+    const auto problem = for_each_residual_block(model, records, options, s, gi, [&](std::span<const ResidualRow> rows) {
+      buffer.clear();
+      for (const auto& r : rows)
+        fmt::format_to(std::back_inserter(buffer), "{},{},{},{},{},{},{}\n", gi + 1, r.equation + 1, records[r.record].path, r.time, r.known,
+                       r.known - r.residual, r.residual);
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    });
+    if (problem || !out) return false;
   }
+  return static_cast<bool>(out);
+}
+
+// Validation (thesis section 2-4, issue 5): the fitted equations solved and compared with each
+// record. Skipped, with one line saying why, when the equations cannot be solved for their highest
+// derivatives or the fit is not usable; never an error of the fit itself.
+struct Validation {
+  std::string note;  // why it was skipped; empty when it ran
+  std::vector<ValidationSummary> runs;
+  std::string method = "RK4, 4 steps per sample interval";
+  std::size_t max_samples = 0;  // per record, 0 = all
+};
+
+Validation validate_fit(const CompiledModel& compiled, const FitSummary& summary, const std::vector<const SampledRecord*>& records,
+                        const FitOptions& options, std::size_t max_samples) {
+  Validation v;
+  v.max_samples = max_samples;
+  if (!summary.is_solution_usable()) {
+    v.note = "skipped: the fit is rank deficient, so its parameters are not worth simulating";
+    return v;
+  }
+  const ir::Model& model = compiled.normalized;
+  auto form = explicit_form(model);
+  if (auto* d = std::get_if<Diagnostic>(&form)) {
+    v.note = "skipped: " + d->message;
+    return v;
+  }
+  std::vector<double> parameters(model.parameters.size(), 0.0);
+  for (const auto& g : summary.groups)
+    for (const auto& p : g.summary.parameters)
+      if (const int i = model.parameter_index(p.name); i >= 0) parameters[static_cast<std::size_t>(i)] = p.value;
+  ValidationOptions o;
+  o.derivative = options.evaluation.derivative;
+  o.max_samples = max_samples;
+  for (const SampledRecord* record : records) {
+    auto run = validate(model, std::get<ExplicitForm>(form), parameters, *record, o);
+    if (auto* d = std::get_if<Diagnostic>(&run)) {
+      v.note = "skipped: " + d->message;
+      v.runs.clear();
+      return v;
+    }
+    v.runs.push_back(std::get<ValidationSummary>(std::move(run)));
+  }
+  return v;
+}
+
+std::string validation_report(const Validation& v) {
+  if (!v.note.empty()) return "\nvalidation: " + v.note + "\n";
+  std::string out;
+  for (const auto& run : v.runs) {
+    out += "\n" + run.report(v.method);
+    if (v.max_samples > 0 && run.outputs.size() > 0 && run.simulation.time.size() >= v.max_samples)
+      out += fmt::format("  (the first {} samples only: --validate-samples N compares more, 0 all; about 16 equation evaluations a sample)\n",
+                         v.max_samples);
+  }
+  return out;
+}
+
+nlohmann::ordered_json validation_json(const Validation& v) {
+  using nlohmann::ordered_json;
+  ordered_json j;
+  j["method"] = v.method;
+  j["note"] = v.note.empty() ? ordered_json(nullptr) : ordered_json(v.note);
+  ordered_json runs = ordered_json::array();
+  for (const auto& run : v.runs) {
+    ordered_json outputs = ordered_json::array();
+    for (const auto& r : run.outputs)
+      outputs.push_back({{"output", r.output}, {"samples", r.samples}, {"max_abs_error", r.max_abs_error}, {"time_of_max_abs_error", r.time_of_max},
+                         {"percent_error", r.percent_error}, {"fit_percent", r.fit_percent}, {"rms_error", r.rms_error}});
+    ordered_json initial = ordered_json::object();
+    for (const auto& [name, value] : run.initial_state) initial[name] = value;
+    runs.push_back({{"record", run.record}, {"completed", run.simulation.completed()},
+                    {"stopped_at", run.simulation.stopped_at ? ordered_json(*run.simulation.stopped_at) : ordered_json(nullptr)},
+                    {"statement", run.statement}, {"initial_state", initial}, {"steps", run.simulation.steps}, {"outputs", outputs}});
+  }
+  j["records"] = std::move(runs);
+  return j;
+}
+
+std::string validation_csv(const Validation& v) {
+  if (v.runs.empty()) return {};
+  std::string out = "record,t";
+  for (const auto& name : v.runs.front().simulation.output_names) out += fmt::format(",{0}_recorded,{0}_simulated,{0}_error", name);
+  out += "\n";
+  for (const auto& run : v.runs)
+    for (std::size_t i = 0; i < run.simulation.time.size(); ++i) {
+      out += fmt::format("{},{}", run.record, run.simulation.time[i]);
+      for (std::size_t j = 0; j < run.outputs.size(); ++j) out += fmt::format(",{},{},{}", run.recorded[j][i], run.simulated[j][i], run.error[j][i]);
+      out += "\n";
+    }
   return out;
 }
 
@@ -183,58 +252,25 @@ struct ModelTotals {
 
 int fit_one(const std::string& compiled_path, const FitArguments& a, const std::string& out_dir, ModelTotals* totals) {
   std::string error;
-  auto compiled = load_compiled(compiled_path, error);
+  auto compiled = load_compiled_model(compiled_path, error);
   if (!compiled) {
     std::cerr << error << "\n";
     return exit_code::user_error;
   }
   const ir::Model& model = compiled->integrated;
-  auto options = fit_options(model, a, error);
+  auto options = fit_options(model, a.records, error);
   if (!options) {
     std::cerr << error << "\n";
     return exit_code::usage_error;
   }
 
-  // Records: from the command line, else the model's data statements (paths relative to the model).
-  std::vector<ir::DataSource> sources;
-  const fs::path base = fs::path(compiled_path).parent_path();
-  if (!a.data.empty()) {
-    for (const auto& path : a.data) {
-      ir::DataSource s = model.data.empty() ? ir::DataSource{} : model.data.front();
-      s.path = path;
-      sources.push_back(std::move(s));
-    }
-  } else {
-    for (auto s : model.data) {
-      if (fs::path(s.path).is_relative()) s.path = (base / s.path).lexically_normal().string();
-      sources.push_back(std::move(s));
-    }
-  }
-  if (sources.empty()) {
-    std::cerr << render(diag::no_data_file(Span{compiled->source, 0, 0})) << "\n";
+  auto loaded = load_records(*compiled, compiled_path, a.records, error);
+  if (!loaded) {
+    std::cerr << error << "\n";
     return exit_code::user_error;
   }
-  const EvaluationSettings e = evaluation_settings(model.settings);
-  BindOptions bind;
-  bind.every = a.every.value_or(e.every);
-  bind.step = a.step ? a.step : e.step;
-  bind.resample = a.resample;
-  if (!a.weights.empty()) bind.weights = a.weights;
-  else bind.weights = e.weights;
-  std::vector<SampledRecord> records;
-  for (const auto& s : sources) {
-    auto record = read_csv(s.path);
-    if (auto* d = std::get_if<Diagnostic>(&record)) {
-      std::cerr << render(*d) << "\n";
-      return exit_code::user_error;
-    }
-    auto bound = bind_record(std::get<Record>(record), s, model, bind);
-    if (auto* d = std::get_if<Diagnostic>(&bound)) {
-      std::cerr << render(*d) << "\n";
-      return exit_code::user_error;
-    }
-    records.push_back(std::get<SampledRecord>(std::move(bound)));
-  }
+  const std::vector<ir::DataSource>& sources = loaded->sources;
+  const std::vector<SampledRecord>& records = loaded->records;
 
   auto result = fit(model, records, *options);
   if (auto* d = std::get_if<Diagnostic>(&result)) {
@@ -243,6 +279,39 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   }
   const FitSummary& summary = std::get<FitSummary>(result);
   std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << summary.full_report(model);
+  std::optional<Validation> validation;
+  if (!a.no_validate) {
+    // The fitted records, then those given only to be compared with (not copied: records can be long).
+    std::vector<SampledRecord> extra;
+    for (const auto& path : a.validate) {
+      auto record = load_record(model, path, loaded->bind, error);
+      if (!record) {
+        std::cerr << error << "\n";
+        return exit_code::user_error;
+      }
+      extra.push_back(std::move(*record));
+    }
+    std::vector<const SampledRecord*> checked;
+    for (const auto& r : records) checked.push_back(&r);
+    for (const auto& r : extra) checked.push_back(&r);
+    validation = validate_fit(*compiled, summary, checked, *options, a.validate_samples);
+    std::cout << validation_report(*validation);
+  }
+  const ResidualAnalysis residuals = analyse_residuals(model, summary, records, *options);
+  std::cout << residual_report(residuals);
+  if (!a.plots.empty() || !a.report.empty()) {
+    static const std::vector<ValidationSummary> none;
+    const PictureContext context{*compiled, compiled_path, summary, *options, records, sources,
+                                 validation ? validation->runs : none, validation ? validation->note : std::string("was switched off (--no-validate)"),
+                                 residuals};
+    std::vector<std::string> written;
+    if (!write_fit_pictures(context, {a.plots, a.report}, written, error)) {
+      std::cerr << error << "\n";
+      return exit_code::user_error;
+    }
+    if (!a.plots.empty()) std::cerr << fmt::format("wrote {} pictures into {}\n", written.size() - (a.report.empty() ? 0 : 1), a.plots);
+    if (!a.report.empty()) std::cerr << "wrote " << a.report << "\n";
+  }
   if (totals) {
     totals->name = model.name.empty() ? compiled_path : model.name;
     totals->usable = summary.is_solution_usable();
@@ -255,12 +324,19 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     fs::create_directories(out_dir, ec);
     const std::string json_path = (fs::path(out_dir) / "fit.json").string();
     const std::string csv_path = (fs::path(out_dir) / "residuals.csv").string();
-    if (ec || !write_file_atomically(json_path, fit_json(summary, *compiled, compiled_path, *options).dump(1) + "\n", error) ||
-        !write_file_atomically(csv_path, residuals_csv(summary), error)) {
+    auto json = fit_json(summary, *compiled, compiled_path, *options);
+    if (validation) json["validation"] = validation_json(*validation);
+    json["residual_analysis"] = residual_json(residuals);
+    const std::string validation_path = (fs::path(out_dir) / "validation.csv").string();
+    const bool curves = validation && !validation->runs.empty();
+    if (ec || !write_file_atomically(json_path, json.dump(1) + "\n", error) ||
+        !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, records, *options, summary); }, error) ||
+        (curves && !write_file_atomically(validation_path, validation_csv(*validation), error))) {
       std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", out_dir, ec.message()) : error) << "\n";
       return exit_code::user_error;
     }
-    std::cerr << "wrote " << json_path << " and " << csv_path << "\n";
+    if (curves) std::cerr << "wrote " << json_path << ", " << csv_path << " and " << validation_path << "\n";
+    else std::cerr << "wrote " << json_path << " and " << csv_path << "\n";
   }
   if (!summary.is_solution_usable()) {
     std::cerr << "error: the least-squares problem is rank deficient: some operations are (nearly) dependent (see the report)\n"
@@ -317,6 +393,11 @@ int run_fit(const FitArguments& a) {
     compiled_paths.push_back(*found);
   }
   if (compiled_paths.size() == 1) return fit_one(compiled_paths.front(), a, a.out, nullptr);
+  if (!a.plots.empty() || !a.report.empty()) {
+    std::cerr << "error: --plots and --report draw one model's fit, and " << compiled_paths.size() << " models were given\n"
+              << "hint: fit the models together for the comparison table, and each alone with --plots or --report\n";
+    return exit_code::usage_error;
+  }
   std::vector<ModelTotals> totals;
   int status = exit_code::success;
   for (const auto& path : compiled_paths) {
@@ -332,16 +413,6 @@ int run_fit(const FitArguments& a) {
   return status;
 }
 
-// CLI11's own range check prints the whole range of a double; say it plainly.
-const CLI::Validator positive = CLI::Validator(
-    [](std::string& value) -> std::string {
-      double x = 0;
-      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
-      if (ec != std::errc() || end != value.data() + value.size() || !(x > 0) || !std::isfinite(x))
-        return "`" + value + "` is not a positive number";
-      return {};
-    },
-    "POSITIVE");
 
 }  // namespace
 
@@ -349,20 +420,13 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   auto a = std::make_shared<FitArguments>();
   CLI::App* cmd = app.add_subcommand("fit", "Determine the parameters of a compiled model from records (thesis section 2-1)");
   cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json), or model files (.sid) to compile first; default: the most recent compiled model here");
-  cmd->add_option("--data", a->data, "Record(s) to fit instead of the model's data statements (CSV)");
-  cmd->add_option("--from", a->from, "Start of the fit window (time)");
-  cmd->add_option("--to", a->to, "End of the fit window (time)");
-  cmd->add_option("--every", a->every, "Keep every K-th sample")->check(positive);
-  cmd->add_option("--step", a->step, "Sampling step, for records without a time column")->check(positive);
-  cmd->add_option("--resample", a->resample, "Interpolate the record linearly onto this uniform step")->check(positive);
-  cmd->add_option("--derivative", a->derivative, "Moving-arc operator, e.g. \"savgol(7, 3)\"");
-  cmd->add_option("--second-derivative", a->second_derivative, "repeated (eq. 3-1.8) or direct")->check(CLI::IsMember({"repeated", "direct"}));
-  cmd->add_option("--edges", a->edges, "drop (the thesis) or shorten")->check(CLI::IsMember({"drop", "shorten"}));
-  cmd->add_option("--integration", a->integration, "simpson or trapezoid")->check(CLI::IsMember({"simpson", "trapezoid"}));
-  cmd->add_option("--precision", a->precision, "Least-squares arithmetic: automatic, double or extended")
-      ->check(CLI::IsMember({"automatic", "double", "extended"}));
-  cmd->add_option("--weights", a->weights, "A record column weighting each row's residual (eq. 2-1.6)");
-  cmd->add_option("--out", a->out, "Directory for fit.json and residuals.csv");
+  add_record_options(cmd, a->records);
+  cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv and validation.csv");
+  cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all)");
+  cmd->add_option("--plots", a->plots, "Directory for the pictures (SVG and PNG, drawn by gnuplot): outputs, errors, functions, residual tests");
+  cmd->add_option("--report", a->report, "Write a one-page HTML report with the fit's tables and pictures to this file");
+  cmd->add_flag("--no-validate", a->no_validate, "Do not solve the fitted equations and compare them with the records (thesis section 2-4)");
+  cmd->add_option("--validate", a->validate, "Also compare the solved fitted equations with this record, not used in fitting (repeatable)")->allow_extra_args(false);
   cmd->callback([a, &exit_status] { exit_status = run_fit(*a); });
 }
 

@@ -7,6 +7,8 @@
 #include "cli/compile_command.hpp"
 #include "cli/exit_codes.hpp"
 #include "cli/fit_command.hpp"
+#include "cli/simulate_command.hpp"
+#include "cli/select_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"sidc: identify the parameters and operations of dynamic systems from recorded data\n"
@@ -17,6 +19,8 @@ int main(int argc, char** argv) {
   try {
     sidc::add_compile_command(app, exit_status);
     sidc::add_fit_command(app, exit_status);
+    sidc::add_simulate_command(app, exit_status);
+    sidc::add_select_command(app, exit_status);
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

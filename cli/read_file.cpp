@@ -26,12 +26,13 @@ std::optional<std::string> read_whole_file(const std::string& path, std::string&
   return std::move(contents).str();
 }
 
-bool write_file_atomically(const std::string& path, const std::string& contents, std::string& error) {
+bool write_file_atomically(const std::string& path, const std::function<bool(std::ostream&)>& write, std::string& error) {
   const std::string temporary = path + ".partial";
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out || !(out << contents) || !(out.flush())) {
+    if (!out || !write(out) || !(out.flush())) {
       error = fmt::format("error: cannot write `{}`: {}", path, std::strerror(errno));
+      out.close();
       std::remove(temporary.c_str());
       return false;
     }
@@ -44,6 +45,10 @@ bool write_file_atomically(const std::string& path, const std::string& contents,
     return false;
   }
   return true;
+}
+
+bool write_file_atomically(const std::string& path, const std::string& contents, std::string& error) {
+  return write_file_atomically(path, [&](std::ostream& out) { return static_cast<bool>(out << contents); }, error);
 }
 
 }  // namespace sidc

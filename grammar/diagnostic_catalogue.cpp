@@ -442,6 +442,14 @@ Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size
                fmt::format("the moving-arc derivatives lose {} samples at each edge; use a longer record, a wider window "
                            "(`set from`/`set to`), fewer parameters, or `set edges = shorten`", margin));
 }
+
+Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record) {
+  return error("weight-not-valid", where,
+               fmt::format("the weights `{}` are {} at t = {} in `{}`; a weight must be a finite number >= 0 (eq. 2-1.6)", weights,
+                           value, time, record),
+               "write the weights so that they cannot go negative (e.g. a square or an abs()), or narrow the fit window with "
+               "`set from`/`set to`");
+}
 // [end of compiler-owned section]
 
 // ---- simulation (compiler/explicit_form.cpp, runtime/simulate.cpp)

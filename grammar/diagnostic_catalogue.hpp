@@ -141,6 +141,8 @@ Diagnostic initial_value_outside_record(const Span& where, std::string_view valu
 Diagnostic no_data_file(const Span& where);
 Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record);
 Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin);
+// `set weights = <expression>` (eq. 2-1.6) is negative, NaN or infinite on a row of the fit window.
+Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record);
 // [end of compiler-owned section]
 // ---- simulation (compiler/explicit_form.cpp, runtime/simulate.cpp)
 Diagnostic simulate_integral(const Span& where, std::string_view term);

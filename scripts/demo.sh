@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job on the bundled example: sets up and builds (scripts/setup.sh), then compiles the
-# thesis section 4-1 model and fits it to the thesis Appendix A record (examples/thesis-4-1/).
+# The main job on the bundled examples: sets up and builds (scripts/setup.sh), then compiles the
+# thesis section 4-1 model and fits it to the thesis Appendix A record (examples/thesis-4-1/),
+# then does the same for the section 4-2 process and the Silverbox record, each with its pictures.
 # Relies on: scripts/setup.sh producing build/cli/sidc. Guarantees: says which step it runs,
 # works from any current directory, stops at the first failing step.
 set -euo pipefail
@@ -11,8 +12,19 @@ bash "$repo_root/scripts/setup.sh"
 sidc="$repo_root/build/cli/sidc"
 [[ -x "$sidc" ]] || { echo "demo.sh: error: $sidc was not built" >&2; exit 1; }
 
-cd "$repo_root/examples/thesis-4-1"
-echo "demo.sh: step 1 of 2: sidc compile quasi_linear.sid (in examples/thesis-4-1)"
-../../build/cli/sidc compile quasi_linear.sid
-echo "demo.sh: step 2 of 2: sidc fit (in examples/thesis-4-1)"
-../../build/cli/sidc fit
+# Each example: `sidc compile MODEL && sidc fit --plots DIR --report DIR/report.html`, pictures
+# (SVG and PNG, drawn by gnuplot) into build/pictures/<example>/.
+pictures="$repo_root/build/pictures"
+run_example() {  # folder, model, step number
+  local folder=$1 model=$2 step=$3
+  local out="$pictures/$folder"
+  cd "$repo_root/examples/$folder"
+  echo "demo.sh: step $step of 3: sidc compile $model && sidc fit --plots $out (in examples/$folder)"
+  "$sidc" compile "$model"
+  rm -rf "$out"
+  "$sidc" fit --plots "$out" --report "$out/report.html"
+}
+run_example thesis-4-1 quasi_linear.sid 1
+run_example thesis-4-2 process.sid 2
+run_example silverbox derivative_form.sid 3
+echo "demo.sh: pictures and one-page reports in $pictures/{thesis-4-1,thesis-4-2,silverbox}/"

@@ -135,18 +135,20 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
 // residuals.csv, written as the rows come: a streamed fit evaluates them again block by block
 // (runtime/fit.hpp, for_each_residual_block), so the file never has to be held in memory.
 bool write_residuals(std::ostream& out, const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
-                     const FitSummary& s) {
+                     const FitSummary& s, std::string& problem) {
   out << "group,equation,record,t,known,fitted,residual\n";
   fmt::memory_buffer buffer;
   for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
-    const auto problem = for_each_residual_block(model, records, options, s, gi, [&](std::span<const ResidualRow> rows) {
+    const auto d = for_each_residual_block(model, records, options, s, gi, [&](std::span<const ResidualRow> rows) {
       buffer.clear();
       for (const auto& r : rows)
         fmt::format_to(std::back_inserter(buffer), "{},{},{},{},{},{},{}\n", gi + 1, r.equation + 1, records[r.record].path, r.time, r.known,
                        r.known - r.residual, r.residual);
       out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      return static_cast<bool>(out);
     });
-    if (problem || !out) return false;
+    if (d) problem = render(*d);
+    if (d || !out) return false;
   }
   return static_cast<bool>(out);
 }
@@ -159,10 +161,11 @@ struct Validation {
   std::vector<ValidationSummary> runs;
   std::string method = "RK4, 4 steps per sample interval";
   std::size_t max_samples = 0;  // per record, 0 = all
+  std::string failed_record;    // a --validate record that could not be compared: an error
 };
 
 Validation validate_fit(const CompiledModel& compiled, const FitSummary& summary, const std::vector<const SampledRecord*>& records,
-                        const FitOptions& options, std::size_t max_samples) {
+                        std::size_t fitted_records, const FitOptions& options, std::size_t max_samples) {
   Validation v;
   v.max_samples = max_samples;
   if (!summary.is_solution_usable()) {
@@ -182,12 +185,15 @@ Validation validate_fit(const CompiledModel& compiled, const FitSummary& summary
   ValidationOptions o;
   o.derivative = options.evaluation.derivative;
   o.max_samples = max_samples;
-  for (const SampledRecord* record : records) {
-    auto run = validate(model, std::get<ExplicitForm>(form), parameters, *record, o);
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    auto run = validate(model, std::get<ExplicitForm>(form), parameters, *records[r], o);
     if (auto* d = std::get_if<Diagnostic>(&run)) {
-      v.note = "skipped: " + d->message;
-      v.runs.clear();
-      return v;
+      if (r >= fitted_records) {  // a --validate record the user named: its problem is an error
+        v.failed_record = fmt::format("error: cannot validate against `{}`: {}", records[r]->path, render(*d));
+        return v;
+      }
+      v.note = fmt::format("skipped for `{}`: {}", records[r]->path, d->message);
+      continue;
     }
     v.runs.push_back(std::get<ValidationSummary>(std::move(run)));
   }
@@ -195,11 +201,11 @@ Validation validate_fit(const CompiledModel& compiled, const FitSummary& summary
 }
 
 std::string validation_report(const Validation& v) {
-  if (!v.note.empty()) return "\nvalidation: " + v.note + "\n";
   std::string out;
+  if (!v.note.empty()) out += "\nvalidation: " + v.note + "\n";
   for (const auto& run : v.runs) {
     out += "\n" + run.report(v.method);
-    if (v.max_samples > 0 && run.outputs.size() > 0 && run.simulation.time.size() >= v.max_samples)
+    if (run.truncated)
       out += fmt::format("  (the first {} samples only: --validate-samples N compares more, 0 all; about 16 equation evaluations a sample)\n",
                          v.max_samples);
   }
@@ -294,11 +300,39 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     std::vector<const SampledRecord*> checked;
     for (const auto& r : records) checked.push_back(&r);
     for (const auto& r : extra) checked.push_back(&r);
-    validation = validate_fit(*compiled, summary, checked, *options, a.validate_samples);
+    validation = validate_fit(*compiled, summary, checked, records.size(), *options, a.validate_samples);
+    if (!validation->failed_record.empty()) {
+      std::cerr << validation->failed_record << "\n";
+      return exit_code::user_error;
+    }
     std::cout << validation_report(*validation);
   }
   const ResidualAnalysis residuals = analyse_residuals(model, summary, records, *options);
   std::cout << residual_report(residuals);
+  if (!out_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    const std::string json_path = (fs::path(out_dir) / "fit.json").string();
+    const std::string csv_path = (fs::path(out_dir) / "residuals.csv").string();
+    auto json = fit_json(summary, *compiled, compiled_path, *options);
+    if (validation) json["validation"] = validation_json(*validation);
+    json["residual_analysis"] = residual_json(residuals);
+    const std::string validation_path = (fs::path(out_dir) / "validation.csv").string();
+    const bool curves = validation && !validation->runs.empty();
+    std::string problem;  // why residuals.csv could not be written, when the rows could not be had
+    if (ec || !write_file_atomically(json_path, json.dump(1) + "\n", error) ||
+        !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, records, *options, summary, problem); }, error) ||
+        (curves && !write_file_atomically(validation_path, validation_csv(*validation), error))) {
+      if (!problem.empty()) error = problem;
+      // No half set of files: a fit.json without its residuals.csv would read as complete.
+      std::error_code ignored;
+      for (const auto& path : {json_path, csv_path, validation_path}) fs::remove(path, ignored);
+      std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", out_dir, ec.message()) : error) << "\n";
+      return exit_code::user_error;
+    }
+    if (curves) std::cerr << "wrote " << json_path << ", " << csv_path << " and " << validation_path << "\n";
+    else std::cerr << "wrote " << json_path << " and " << csv_path << "\n";
+  }
   if (!a.plots.empty() || !a.report.empty()) {
     static const std::vector<ValidationSummary> none;
     const PictureContext context{*compiled, compiled_path, summary, *options, records, sources,
@@ -312,6 +346,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     if (!a.plots.empty()) std::cerr << fmt::format("wrote {} pictures into {}\n", written.size() - (a.report.empty() ? 0 : 1), a.plots);
     if (!a.report.empty()) std::cerr << "wrote " << a.report << "\n";
   }
+  // Last, so that a model whose files could not be written never ranks in the comparison table.
   if (totals) {
     totals->name = model.name.empty() ? compiled_path : model.name;
     totals->usable = summary.is_solution_usable();
@@ -319,25 +354,6 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (const auto& equation : model.equations) totals->known += print(equation.known) + "; ";
   }
 
-  if (!out_dir.empty()) {
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    const std::string json_path = (fs::path(out_dir) / "fit.json").string();
-    const std::string csv_path = (fs::path(out_dir) / "residuals.csv").string();
-    auto json = fit_json(summary, *compiled, compiled_path, *options);
-    if (validation) json["validation"] = validation_json(*validation);
-    json["residual_analysis"] = residual_json(residuals);
-    const std::string validation_path = (fs::path(out_dir) / "validation.csv").string();
-    const bool curves = validation && !validation->runs.empty();
-    if (ec || !write_file_atomically(json_path, json.dump(1) + "\n", error) ||
-        !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, records, *options, summary); }, error) ||
-        (curves && !write_file_atomically(validation_path, validation_csv(*validation), error))) {
-      std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", out_dir, ec.message()) : error) << "\n";
-      return exit_code::user_error;
-    }
-    if (curves) std::cerr << "wrote " << json_path << ", " << csv_path << " and " << validation_path << "\n";
-    else std::cerr << "wrote " << json_path << " and " << csv_path << "\n";
-  }
   if (!summary.is_solution_usable()) {
     std::cerr << "error: the least-squares problem is rank deficient: some operations are (nearly) dependent (see the report)\n"
                  "hint: drop one operation of each dependent group, or give the record more excitation\n";
@@ -425,8 +441,10 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all)");
   cmd->add_option("--plots", a->plots, "Directory for the pictures (SVG and PNG, drawn by gnuplot): outputs, errors, functions, residual tests");
   cmd->add_option("--report", a->report, "Write a one-page HTML report with the fit's tables and pictures to this file");
-  cmd->add_flag("--no-validate", a->no_validate, "Do not solve the fitted equations and compare them with the records (thesis section 2-4)");
-  cmd->add_option("--validate", a->validate, "Also compare the solved fitted equations with this record, not used in fitting (repeatable)")->allow_extra_args(false);
+  auto* no_validate = cmd->add_flag("--no-validate", a->no_validate, "Do not solve the fitted equations and compare them with the records (thesis section 2-4)");
+  cmd->add_option("--validate", a->validate, "Also compare the solved fitted equations with this record, not used in fitting (repeatable)")
+      ->allow_extra_args(false)
+      ->excludes(no_validate);
   cmd->callback([a, &exit_status] { exit_status = run_fit(*a); });
 }
 

@@ -70,11 +70,13 @@ std::optional<std::vector<double>> exact_column(const ir::DataSource& source, co
   const std::vector<double>* values = r.column(column);
   if (!time || !values || time->size() < 2) return std::nullopt;
   const double t0 = time->front(), step = ((*time)[time->size() - 1] - t0) / static_cast<double>(time->size() - 1);
+  if (!(step > 0) || !std::isfinite(step)) return std::nullopt;  // no uniform time column to match by
   std::vector<double> out;
   for (double t : at) {
     const double k = std::round((t - t0) / step);
-    const auto i = static_cast<std::size_t>(std::max(0.0, k));
-    out.push_back(k >= 0 && i < values->size() && std::abs((*time)[i] - t) <= 1e-6 * std::max(1.0, std::abs(t)) + 1e-3 * step
+    const bool inside = std::isfinite(k) && k >= 0 && k < static_cast<double>(values->size());
+    const auto i = inside ? static_cast<std::size_t>(k) : 0;
+    out.push_back(inside && std::abs((*time)[i] - t) <= 1e-6 * std::max(1.0, std::abs(t)) + 1e-3 * step
                       ? (*values)[i]
                       : std::numeric_limits<double>::quiet_NaN());
   }
@@ -241,47 +243,15 @@ ResidualAnalysis analyse_residuals(const ir::Model& model, const FitSummary& sum
   ResidualAnalysis out;
   const auto inputs = input_names(model);
   for (std::size_t g = 0; g < summary.groups.size(); ++g) {
-    // Segments: a new one wherever the equation or the record changes (never correlate across the
-    // join of two records); each input sampled at the rows' times.
-    std::vector<std::vector<double>> residuals;
-    std::vector<InputSegments> input_segments;
-    for (const auto& name : inputs) input_segments.push_back({name, {}});
-    std::size_t rows = 0, last_equation = SIZE_MAX, last_record = SIZE_MAX;
-    bool missing_input = false;
-    const auto problem = for_each_residual_block(model, records, options, summary, g, [&](std::span<const ResidualRow> block) {
-      for (const auto& r : block) {
-        if (rows >= kMaxResidualRows) return;
-        if (r.equation != last_equation || r.record != last_record) {
-          residuals.emplace_back();
-          for (auto& in : input_segments) in.segments.emplace_back();
-          last_equation = r.equation, last_record = r.record;
-        }
-        residuals.back().push_back(r.residual);
-        const SampledRecord& record = records[r.record];
-        const auto k = static_cast<std::size_t>(std::llround((r.time - record.time.front()) / record.step));
-        for (auto& in : input_segments) {
-          auto it = record.signals.find(in.name);
-          if (it == record.signals.end() || k >= it->second.size()) {
-            missing_input = true;
-            in.segments.back().push_back(std::numeric_limits<double>::quiet_NaN());
-          } else {
-            in.segments.back().push_back(it->second[k]);
-          }
-        }
-        ++rows;
-      }
-    });
-    if (problem || missing_input) {
+    const GroupResiduals segments = group_residuals(model, records, options, summary, g, inputs, kMaxResidualRows);
+    out.truncated.push_back(segments.truncated);
+    if (!segments.ok) {
       out.groups.emplace_back();
-      out.notes.push_back(problem ? "not computed: " + problem->message : std::string("not computed: an input has no value at some rows"));
-      out.truncated.push_back(false);
+      out.notes.push_back("not computed: " + segments.message);
       continue;
     }
-    out.groups.push_back(residual_correlation(residuals, input_segments, {}));
-    std::string note;
-    if (!out.groups.back().is_usable()) note = "not computed: " + out.groups.back().message;
-    out.notes.push_back(note);
-    out.truncated.push_back(rows >= kMaxResidualRows);
+    out.groups.push_back(residual_correlation(segments.residuals, segments.inputs, {}));
+    out.notes.push_back(out.groups.back().is_usable() ? std::string() : "not computed: " + out.groups.back().message);
   }
   return out;
 }

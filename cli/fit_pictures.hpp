@@ -31,8 +31,8 @@ struct ResidualAnalysis {
 // finer than any decision needs, and a streamed fit's second pass stays short.
 inline constexpr std::size_t kMaxResidualRows = 1'000'000;
 
-// The residuals, unweighted, come from runtime/fit.hpp's for_each_residual_block: the fit's own
-// for a dense fit, a second pass over row blocks for a streamed one.
+// The residuals come from runtime/residual_correlation.hpp's group_residuals: the fit's own for a
+// dense fit, a second pass over row blocks for a streamed one.
 ResidualAnalysis analyse_residuals(const ir::Model& model, const FitSummary& summary, const std::vector<SampledRecord>& records,
                                    const FitOptions& options);
 std::string residual_report(const ResidualAnalysis& analysis);

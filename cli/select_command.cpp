@@ -1,12 +1,10 @@
 // `sidc select` (see select_command.hpp).
 //
-// Relies on: cli/fit_command.hpp (load_compiled_model), runtime/bind_record.hpp, runtime/select.hpp.
+// Relies on: cli/fit_command.hpp (load_compiled_model), cli/record_options.hpp (the records and
+// evaluation options, shared with sidc fit), runtime/select.hpp, runtime/validate.hpp (--simulate).
 // Guarantees: every bad option is a usage error (exit 2) naming the option, with did-you-mean for
 // parameter names; a bad model or record is a user error (exit 1) rendered as sidc renders
 // diagnostics; nothing is written unless --out is given, and then atomically.
-//
-// The record binding and the evaluation options below repeat what cli/fit_command.cpp does in its
-// own (file-local) fit_options() and fit_one(); they belong in one shared place (reported to the lead).
 #include "cli/select_command.hpp"
 
 #include "cli/record_options.hpp"

@@ -127,6 +127,10 @@ std::string one_of(const json& j, const char* field, std::initializer_list<const
   throw std::runtime_error(fmt::format("`{}` is not a valid {}", value, field));
 }
 
+// No model asks for more (the moving arc of order k needs k*(window-1) samples); larger or
+// negative orders only come from a damaged file.
+constexpr int kMaxOrder = 64;
+
 struct Reader {
   std::shared_ptr<const SourceFile> source;
   std::set<std::string> signals;
@@ -163,6 +167,7 @@ struct Reader {
     if ((*kind == FactorKind::signal || *kind == FactorKind::initial_value) && !signals.count(j.at("name").get<std::string>()))
       throw std::runtime_error("a factor names the undeclared signal `" + j.at("name").get<std::string>() + "`");
     ir::Factor f{*kind, j.value("name", std::string()), j.value("order", 0), {}, {}, {}, {}};
+    if (f.order < 0 || f.order > kMaxOrder) throw std::runtime_error(fmt::format("a derivative order of {}", f.order));
     if (*kind == FactorKind::initial_value && !j.at("at").is_null()) f.at = number(j.at("at"));
     if (j.contains("exponent")) f.exponent = number(j.at("exponent"));
     if (j.contains("argument")) f.argument = sum_ptr(j.at("argument"));
@@ -329,7 +334,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
         const std::string signal = x.at("signal").get<std::string>();
         if (!r.signals.count(signal)) throw std::runtime_error("an exact derivative names the undeclared signal `" + signal + "`");
         const int order = x.at("order").get<int>();
-        if (order < 1) throw std::runtime_error("an exact derivative of order below 1");
+        if (order < 1 || order > kMaxOrder) throw std::runtime_error(fmt::format("an exact derivative of order {}", order));
         source.exact_derivatives.push_back({signal, order, x.at("column").get<std::string>(), {}});
       }
       m.data.push_back(std::move(source));
@@ -347,6 +352,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       plot.signal = p.at("signal").get<std::string>();
       if (!r.signals.count(plot.signal)) throw std::runtime_error("a plot names the undeclared signal `" + plot.signal + "`");
       plot.order = p.at("order").get<int>();
+      if (plot.order < 0 || plot.order > kMaxOrder) throw std::runtime_error(fmt::format("a plot against a derivative of order {}", plot.order));
       plot.terms = read_operations(p.at("operations"), normalized, r);
       plot.rest = r.sum(p.at("rest"));
       if (!p.at("truth").is_null()) plot.truth = r.sum(p.at("truth"));

@@ -67,9 +67,9 @@ struct name_parser : x3::parser<name_parser> {
   template <typename Iterator>
   static bool is_reserved(Iterator first, Iterator last) {
     static constexpr std::string_view words[] = {"model", "input", "output", "param", "const", "data",
-                                                 "set",   "and",   "sum",    "der",   "int",    "plot"};
+                                                 "set",   "and",   "sum",    "der",   "int",    "plot",  "against"};
     const auto length = static_cast<std::size_t>(last - first);
-    if (length < 3 || length > 6) return false;
+    if (length < 3 || length > 7) return false;
     const std::string_view word(&*first, length);
     for (std::string_view reserved : words)
       if (word == reserved) return true;

@@ -97,17 +97,6 @@ std::optional<Diagnostic> invalid_weight(const ir::Model& model, const SampledRe
   return std::nullopt;
 }
 
-// The dense path's row weights of one record from the expression, on its fit window, checked.
-std::variant<std::vector<double>, Diagnostic> expression_weights(const ir::Model& model, Evaluator& evaluator) {
-  auto values = evaluator.evaluate(model.weights->value);
-  if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-  const auto& v = std::get<std::vector<double>>(values);
-  const FitWindow& w = evaluator.window();
-  std::vector<double> window(v.begin() + static_cast<std::ptrdiff_t>(w.first), v.begin() + static_cast<std::ptrdiff_t>(w.first + w.size()));
-  if (auto problem = invalid_weight(model, evaluator.record(), window, w.first)) return *problem;
-  return window;
-}
-
 // What the streamed path needs besides the model and the records, shared read-only by its threads.
 struct StreamPlan {
   const ir::Model& model;
@@ -332,6 +321,17 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
 
 }  // namespace
 
+// The row weights of one record from the expression, on its fit window, checked.
+std::variant<std::vector<double>, Diagnostic> expression_weights(const ir::Model& model, Evaluator& evaluator) {
+  auto values = evaluator.evaluate(model.weights->value);
+  if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+  const auto& v = std::get<std::vector<double>>(values);
+  const FitWindow& w = evaluator.window();
+  std::vector<double> window(v.begin() + static_cast<std::ptrdiff_t>(w.first), v.begin() + static_cast<std::ptrdiff_t>(w.first + w.size()));
+  if (auto problem = invalid_weight(model, evaluator.record(), window, w.first)) return *problem;
+  return window;
+}
+
 bool FitOptions::is_valid(std::string* why) const {
   if (from && to && *from > *to) {
     if (why) *why = fmt::format("the fit window starts at {} after it ends at {}", *from, *to);
@@ -453,7 +453,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
 
 std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                   const FitOptions& options, const FitSummary& summary, std::size_t group,
-                                                  const std::function<void(std::span<const ResidualRow>)>& rows) {
+                                                  const std::function<bool(std::span<const ResidualRow>)>& rows) {
   if (group >= summary.groups.size()) return std::nullopt;
   const GroupFit& g = summary.groups[group];
   std::vector<ResidualRow> block;
@@ -465,7 +465,7 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
         const double r = i < g.summary.residuals.size() ? g.summary.residuals[i] : std::numeric_limits<double>::quiet_NaN();
         block.push_back({g.row_equation[i], g.row_record[i], g.row_time[i], g.known[i], r});
       }
-      rows(block);
+      if (!rows(block)) return std::nullopt;
     }
     return std::nullopt;
   }
@@ -505,7 +505,7 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
         block.clear();
         for (std::size_t i = 0; i < m; ++i)
           block.push_back({e, r, records[r].time[w.first + start + i], b(static_cast<Eigen::Index>(i)), residuals(static_cast<Eigen::Index>(i))});
-        rows(block);
+        if (!rows(block)) return std::nullopt;
       }
     }
   }

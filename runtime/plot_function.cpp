@@ -3,9 +3,15 @@
 #include <array>
 #include <limits>
 
+#include "grammar/diagnostic_catalogue.hpp"
 #include "runtime/point_evaluator.hpp"
 
 namespace sidc {
+namespace {
+
+std::string curve_argument(const ir::PlotFunction& plot) { return plot.signal + std::string(static_cast<std::size_t>(plot.order), '\''); }
+
+}  // namespace
 
 std::variant<PlotCurve, Diagnostic> evaluate_plot_function(const ir::PlotFunction& plot, const std::vector<double>& parameters,
                                                            double low, double high, int points) {
@@ -26,9 +32,13 @@ std::variant<PlotCurve, Diagnostic> evaluate_plot_function(const ir::PlotFunctio
     if (auto* d = std::get_if<Diagnostic>(&t)) return *d;
     truth = std::get<PointSum>(std::move(t));
   }
+  // The compiler allows only the argument; a damaged compiled file could name more.
+  if (layout.size() != 1)
+    return diag::plot_uses_other_quantity(plot.span, plot.name, layout.slots()[1].first + std::string(static_cast<std::size_t>(layout.slots()[1].second), '\''),
+                                          curve_argument(plot));
   PlotCurve curve;
   curve.name = plot.name;
-  curve.argument = plot.signal + std::string(static_cast<std::size_t>(plot.order), '\'');
+  curve.argument = curve_argument(plot);
   if (points < 2) points = 2;
   std::array<double, 1> slot{};
   for (int i = 0; i < points; ++i) {

@@ -141,52 +141,55 @@ std::vector<std::pair<std::size_t, std::size_t>> contiguous_segments(const std::
   return out;
 }
 
-GroupResiduals group_residuals(const GroupFit& group, const std::vector<SampledRecord>& records,
-                               const std::vector<std::string>& input_names) {
+GroupResiduals group_residuals(const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
+                               const FitSummary& summary, std::size_t group, const std::vector<std::string>& input_names,
+                               std::size_t max_rows) {
   GroupResiduals out;
-  const auto& residuals = group.summary.residuals;
-  const std::size_t rows = group.row_record.size();
-  if (residuals.size() != rows || group.row_equation.size() != rows) {
-    out.message = residuals.empty() ? "the fit kept no residuals (rows were streamed)"
-                                    : fmt::format("{} residuals for {} rows", residuals.size(), rows);
+  for (const auto& name : input_names) out.inputs.push_back({name, {}});
+  if (group >= summary.groups.size()) {
+    out.message = fmt::format("there is no equation group {}", group + 1);
     return out;
   }
-  for (auto& name : input_names) out.inputs.push_back({name, {}});
-  std::vector<std::size_t> key(rows);
-  std::size_t equations = 1;
-  for (std::size_t e : group.row_equation) equations = std::max(equations, e + 1);
-  for (std::size_t i = 0; i < rows; ++i) key[i] = group.row_record[i] * equations + group.row_equation[i];
-  for (const auto& [begin, end] : contiguous_segments(key)) {
-    const std::size_t r = group.row_record[begin];
-    if (r >= records.size() || r >= group.records.size()) {
-      out.message = fmt::format("row {} names record {}, but {} were given", begin + 1, r + 1, records.size());
-      return out;
-    }
-    const auto& record = records[r];
-    const std::size_t first = group.records[r].first_sample;
-    if (first + (end - begin) > record.time.size()) {
-      out.message = fmt::format("record {} has {} samples, the fit's rows reach sample {}", record.path,
-                                record.time.size(), first + (end - begin));
-      return out;
-    }
-    std::vector<double> segment(end - begin);
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::size_t sample = first + (i - begin);
-      const double weight = sample < record.weights.size() ? record.weights[sample] : 1.0;
-      segment[i - begin] = weight * residuals[i];
-    }
-    out.residuals.push_back(std::move(segment));
-    for (auto& input : out.inputs) {
-      const auto found = record.signals.find(input.name);
-      if (found == record.signals.end()) {
-        out.message = fmt::format("record {} has no signal `{}`", record.path, input.name);
-        return out;
+  std::size_t rows = 0, last_equation = SIZE_MAX, last_record = SIZE_MAX;
+  const auto problem = for_each_residual_block(model, records, options, summary, group, [&](std::span<const ResidualRow> block) {
+    for (const auto& r : block) {
+      if (rows >= max_rows) {
+        out.truncated = true;
+        return false;
       }
-      input.segments.emplace_back(found->second.begin() + static_cast<long>(first),
-                                  found->second.begin() + static_cast<long>(first + (end - begin)));
+      if (r.record >= records.size()) {
+        out.message = fmt::format("a row names record {}, but {} were given", r.record + 1, records.size());
+        return false;
+      }
+      const SampledRecord& record = records[r.record];
+      // A new segment wherever the equation or the record changes: the join is no time step.
+      if (r.equation != last_equation || r.record != last_record) {
+        out.residuals.emplace_back();
+        for (auto& in : out.inputs) in.segments.emplace_back();
+        last_equation = r.equation, last_record = r.record;
+      }
+      const double position = record.step > 0 ? (r.time - record.time.front()) / record.step : 0;
+      const auto sample = static_cast<std::size_t>(std::max(0.0, std::round(position)));
+      if (sample >= record.time.size()) {
+        out.message = fmt::format("a row at t = {} lies beyond record {}", r.time, record.path);
+        return false;
+      }
+      const double weight = sample < record.weights.size() ? record.weights[sample] : 1.0;
+      out.residuals.back().push_back(weight * r.residual);
+      for (auto& in : out.inputs) {
+        const auto found = record.signals.find(in.name);
+        if (found == record.signals.end() || sample >= found->second.size()) {
+          out.message = fmt::format("record {} has no signal `{}`", record.path, in.name);
+          return false;
+        }
+        in.segments.back().push_back(found->second[sample]);
+      }
+      ++rows;
     }
-  }
-  out.ok = true;
+    return true;
+  });
+  if (problem) out.message = problem->message;
+  out.ok = out.message.empty();
   return out;
 }
 

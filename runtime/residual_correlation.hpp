@@ -95,19 +95,23 @@ ResidualCorrelationSummary residual_correlation(const std::vector<std::vector<do
                                                 const std::vector<InputSegments>& inputs,
                                                 const ResidualCorrelationOptions& options);
 
-// The residuals of one fitted group (runtime/fit.hpp) as contiguous segments, one per record and
-// equation in the order of the rows, and the named record signals at the same samples (the inputs
-// of the cross-correlation). Residuals are multiplied by the record's weights when it has them
-// (eq. 2-1.6: the weighted residuals are the ones the fit treats alike). ok = false with a message
-// when the fit kept no residuals (a streamed fit) or a signal is missing from a record.
+// The residuals of group `group` of a fit (runtime/fit.hpp) as contiguous segments, one per record
+// and equation in the order of the rows, and the named record signals at the same samples (the
+// inputs of the cross-correlation). The rows come from for_each_residual_block: the fit's own for
+// a dense fit, a second pass over row blocks for a streamed one, at most `max_rows` of them (then
+// `truncated`). Residuals are multiplied by the record's weight column when it has one (eq. 2-1.6:
+// the weighted residuals are the ones the fit treats alike). ok = false with a message when the
+// rows cannot be had or a signal is missing from a record.
 struct GroupResiduals {
   bool ok = false;
   std::string message;
   std::vector<std::vector<double>> residuals;
   std::vector<InputSegments> inputs;
+  bool truncated = false;
 };
-GroupResiduals group_residuals(const GroupFit& group, const std::vector<SampledRecord>& records,
-                               const std::vector<std::string>& input_names);
+GroupResiduals group_residuals(const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
+                               const FitSummary& summary, std::size_t group, const std::vector<std::string>& input_names,
+                               std::size_t max_rows = static_cast<std::size_t>(-1));
 
 // Splits the rows of a fit into contiguous segments: a new segment starts wherever `key` changes
 // (e.g. key = row_equation * records + row_record). Returns the half-open [begin, end) of each.

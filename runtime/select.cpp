@@ -246,6 +246,13 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
       Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(W * E), p);
       Eigen::VectorXd b(static_cast<Eigen::Index>(W * E));
       Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(W * E));
+      // eq. 2-1.6 as sidc fit applies it: the column's weights times the expression's.
+      std::vector<double> expression;
+      if (model.weights) {
+        auto values = expression_weights(model, evaluator);
+        if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+        expression = std::get<std::vector<double>>(std::move(values));
+      }
       // Row of (equation k, sample i) is i * E + k, so that a block of samples is a block of rows.
       for (std::size_t k = 0; k < E; ++k) {
         const ir::Equation& eq = model.equations[members[k]];
@@ -262,10 +269,12 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
         const auto& v = std::get<std::vector<double>>(known);
         for (std::size_t i = 0; i < W; ++i) {
           b(static_cast<Eigen::Index>(i * E + k)) = v[i];
-          if (!records[r].weights.empty()) weights(static_cast<Eigen::Index>(i * E + k)) = records[r].weights[w.first + i];
+          double weight = records[r].weights.empty() ? 1.0 : records[r].weights[w.first + i];
+          if (!expression.empty()) weight *= expression[i];
+          weights(static_cast<Eigen::Index>(i * E + k)) = weight;
         }
       }
-      const bool weighted = !records[r].weights.empty();
+      const bool weighted = !records[r].weights.empty() || !expression.empty();
       for (int block = 0; block < fine; ++block) {
         const std::size_t first = W * static_cast<std::size_t>(block) / static_cast<std::size_t>(fine);
         const std::size_t last = W * static_cast<std::size_t>(block + 1) / static_cast<std::size_t>(fine);

@@ -76,7 +76,7 @@ struct SelectOptions {
   // Hook for ranking by free-run simulation error (issue 5's runtime/simulate): when set, called
   // for the best subset of every size with the parameter names and values of that subset (all
   // others zero) and the group index; its value (smaller is better) is reported in a `sim` column
-  // and can be the size rule later. Not set by sidc select yet.
+  // and can be the size rule later. sidc select --simulate sets it (cli/select_command.cpp).
   std::function<std::optional<double>(std::size_t group, const std::vector<std::string>& names, const std::vector<double>& values)>
       simulation_error;
 

@@ -45,6 +45,7 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
 
   ValidationSummary v;
   v.record = record.path;
+  v.truncated = static_cast<std::size_t>(to) < record.time.size();
   for (const auto& out : form.outputs)
     for (int m = 0; m < out.order; ++m)
       v.initial_state.emplace_back(out.name + std::string(static_cast<std::size_t>(m), '\''), o.initial[out.name][static_cast<std::size_t>(m)]);

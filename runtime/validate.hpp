@@ -7,7 +7,7 @@
 // so an integrated fit is validated through the equation it integrated; integration constants
 // are not needed. Guarantees: the model is solved from the first sample where every state
 // derivative has its centred moving-arc estimate (t = 3 Delta for y' by the 7-point operator; y
-// itself by value) to the end of the record, inputs taken from the record; per output it gives the error curve E[y] = y_recorded -
+// itself by value) to the end of the record (or ValidationOptions::max_samples later), inputs taken from the record; per output it gives the error curve E[y] = y_recorded -
 // y_simulated (eq. 4-1.4), max |E| and its time, the thesis' percentage error 100 max|E| /
 // max|y_recorded| (eq. 4-1.5: the error over the largest observed magnitude), MATLAB's fit
 // percentage 100 (1 - ||y - yhat|| / ||y - mean(y)||), and the RMS error. A run that diverges or
@@ -52,6 +52,7 @@ struct ValidationSummary {
   std::vector<OutputValidation> outputs;
   std::vector<std::vector<double>> recorded, simulated, error;  // per output, on simulation.time
   std::string statement;  // one plain sentence: how well, or where it diverged
+  bool truncated = false;  // ValidationOptions::max_samples stopped it before the record's end
   std::string report(const std::string& method) const;
 };
 

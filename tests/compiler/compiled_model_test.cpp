@@ -333,6 +333,13 @@ TEST(CompiledModelFile, ReadingBackAndWritingAgainGivesTheSameJson) {
   EXPECT_GE(compared, 100u);
 }
 
+// A plot entry of the model in `j`, against `signal` differentiated `order` times, made of its
+// first equation's first operation (for breaking on purpose).
+json plot_of(const json& j, const std::string& signal, int order) {
+  return {{"name", "f"}, {"text", "plot f"}, {"span", j["signals"][0]["span"]}, {"signal", signal}, {"order", order},
+          {"operations", json::array({j["equations"][0]["operations"][0]})}, {"rest", j["equations"][0]["known"]}, {"truth", nullptr}};
+}
+
 TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
   const json good = van_der_pol();
   std::string error;
@@ -359,6 +366,21 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
        {"m.sidc.json", "compile the model again"}},
       {"operation of an undeclared parameter", [](json& j) { j["equations"][0]["operations"][0]["parameter"] = "b9"; },
        {"undeclared parameter"}},
+      {"a negative derivative order", [&](json& j) {
+         j[first_factor]["kind"] = "signal", j[first_factor]["name"] = "y", j[first_factor]["order"] = -2;
+       }, {"derivative order of -2"}},
+      {"a plot against a negative derivative", [](json& j) { j["plots"] = json::array({plot_of(j, "y", -1)}); }, {"plot", "order -1"}},
+      {"a plot of an undeclared signal", [](json& j) { j["plots"] = json::array({plot_of(j, "z", 1)}); }, {"undeclared signal `z`"}},
+      {"an exact derivative of order 0", [](json& j) {
+         j["data"] = json::array({{{"path", "r.csv"}, {"bindings", json::object()},
+                                   {"exact_derivatives", json::array({{{"signal", "y"}, {"order", 0}, {"column", "v"}}})}}});
+       }, {"exact derivative of order 0"}},
+      {"an exact derivative of an undeclared signal", [](json& j) {
+         j["data"] = json::array({{{"path", "r.csv"}, {"bindings", json::object()},
+                                   {"exact_derivatives", json::array({{{"signal", "q"}, {"order", 1}, {"column", "v"}}})}}});
+       }, {"undeclared signal `q`"}},
+      {"weights that are not a sum", [](json& j) { j["weights_expression"] = {{"expression", 3}, {"span", nullptr}}; },
+       {"m.sidc.json", "compile the model again"}},
   };
   for (const auto& b : breakages) {
     json broken = good;

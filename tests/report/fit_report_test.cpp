@@ -53,7 +53,7 @@ ResidualCorrelationSummary analyse(const ir::Model& model, const std::vector<Sam
   EXPECT_TRUE(std::holds_alternative<FitSummary>(result));
   if (!std::holds_alternative<FitSummary>(result)) return {};
   *fitted = std::get<FitSummary>(result);
-  const auto segments = group_residuals(fitted->groups.at(0), records, {"x"});
+  const auto segments = group_residuals(model, records, {}, *fitted, 0, {"x"});
   EXPECT_TRUE(segments.ok) << segments.message;
   EXPECT_EQ(segments.residuals.size(), records.size());  // one equation: one segment per record
   return residual_correlation(segments.residuals, segments.inputs, {});
@@ -106,26 +106,39 @@ TEST(FitReport, WhiteResidualsOfAGoodModelAndCorrelatedOnesOfAPoorOneReachTheRep
   EXPECT_NE(html.str().find(">a2<"), std::string::npos);
 }
 
-TEST(FitReport, AStreamedOrMismatchedFitSaysWhyThereAreNoResidualSegments) {
-  GroupFit group;
-  group.row_record = {0, 0};
-  group.row_equation = {0, 0};
-  group.row_time = {0, 1};
-  const auto streamed = group_residuals(group, {}, {});
-  EXPECT_FALSE(streamed.ok);
-  EXPECT_NE(streamed.message.find("streamed"), std::string::npos);
-  group.summary.residuals = {0.1, -0.1};
-  group.records.push_back({"r.csv", 0, 1, 1, 0, 2});
-  SampledRecord record;
-  record.path = "r.csv";
-  record.time = {0, 1};
-  record.signals["y"] = {1, 2};
-  const auto missing = group_residuals(group, {record}, {"x"});
+TEST(FitReport, StreamedAndDenseFitsGiveTheSameResidualSegments) {
+  const std::vector<SampledRecord> records = {noisy_record(1, 0.3), noisy_record(2, 1.1)};
+  const ir::Model model = compiled("input x\noutput y\nparam a1, a2\na1*y' + a2*y = x\n");
+  FitOptions dense_options, streamed_options;
+  streamed_options.stream_above_entries = 0;  // every group streamed: residuals by a second pass
+  streamed_options.stream_block_rows = 7;
+  auto dense = fit(model, records, dense_options);
+  auto streamed = fit(model, records, streamed_options);
+  ASSERT_TRUE(std::holds_alternative<FitSummary>(dense));
+  ASSERT_TRUE(std::holds_alternative<FitSummary>(streamed));
+  const auto a = group_residuals(model, records, dense_options, std::get<FitSummary>(dense), 0, {"x"});
+  const auto b = group_residuals(model, records, streamed_options, std::get<FitSummary>(streamed), 0, {"x"});
+  ASSERT_TRUE(a.ok) << a.message;
+  ASSERT_TRUE(b.ok) << b.message;
+  ASSERT_EQ(a.residuals.size(), 2u);  // one segment per record, never joined
+  ASSERT_EQ(b.residuals.size(), 2u);
+  for (std::size_t s = 0; s < 2; ++s) {
+    ASSERT_EQ(a.residuals[s].size(), b.residuals[s].size());
+    for (std::size_t i = 0; i < a.residuals[s].size(); ++i) EXPECT_NEAR(a.residuals[s][i], b.residuals[s][i], 1e-9);
+    EXPECT_EQ(a.inputs[0].segments[s], b.inputs[0].segments[s]);
+  }
+  EXPECT_FALSE(a.truncated);
+
+  const auto first_ten = group_residuals(model, records, dense_options, std::get<FitSummary>(dense), 0, {"x"}, 10);
+  ASSERT_TRUE(first_ten.ok);
+  EXPECT_TRUE(first_ten.truncated);
+  EXPECT_EQ(first_ten.residuals.at(0).size(), 10u);
+
+  const auto missing = group_residuals(model, records, dense_options, std::get<FitSummary>(dense), 0, {"z"});
   EXPECT_FALSE(missing.ok);
-  EXPECT_NE(missing.message.find("no signal `x`"), std::string::npos) << missing.message;
-  const auto fine = group_residuals(group, {record}, {"y"});
-  ASSERT_TRUE(fine.ok) << fine.message;
-  EXPECT_EQ(fine.inputs.at(0).segments.at(0), (std::vector<double>{1, 2}));
+  EXPECT_NE(missing.message.find("no signal `z`"), std::string::npos) << missing.message;
+  const auto no_group = group_residuals(model, records, dense_options, std::get<FitSummary>(dense), 3, {"x"});
+  EXPECT_FALSE(no_group.ok);
 }
 
 }  // namespace

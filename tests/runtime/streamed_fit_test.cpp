@@ -171,9 +171,15 @@ TEST(StreamedFit, ResidualsInASecondPassMatchTheDenseOnes) {
   const FitSummary stream = fitted(m, records, stream_options);
   std::vector<ResidualRow> a, b;
   ASSERT_FALSE(for_each_residual_block(m, records, dense_options, dense, 0,
-                                       [&](std::span<const ResidualRow> rows) { a.insert(a.end(), rows.begin(), rows.end()); }));
+                                       [&](std::span<const ResidualRow> rows) {
+                                         a.insert(a.end(), rows.begin(), rows.end());
+                                         return true;
+                                       }));
   ASSERT_FALSE(for_each_residual_block(m, records, stream_options, stream, 0,
-                                       [&](std::span<const ResidualRow> rows) { b.insert(b.end(), rows.begin(), rows.end()); }));
+                                       [&](std::span<const ResidualRow> rows) {
+                                         b.insert(b.end(), rows.begin(), rows.end());
+                                         return true;
+                                       }));
   ASSERT_EQ(a.size(), dense.groups[0].row_time.size());
   ASSERT_EQ(a.size(), b.size());
   double largest = 0;

@@ -157,6 +157,27 @@ TEST(SelectBinary, SimulationErrorRanksTheTrueSubsetAmongTheBest) {
   EXPECT_TRUE(g["best_size"]["simulation"].is_number());
 }
 
+TEST(SelectBinary, WeightsGivenAsAnExpressionWeighTheRowsAsSidcFitDoes) {
+  // Constant weights 2 (eq. 2-1.6) multiply every residual by 2: the same subsets, G four times.
+  const fs::path model = work() / "weighted.sid";
+  {
+    std::ofstream out(model);
+    out << read_text(kModels / "candidates_integrated.sid") << "set weights = 1 + 1\n";
+  }
+  const auto plain = select_json("candidates_integrated.sid", noisy_record(1e-3), "--require m --folds 0");
+  const fs::path out = work() / "weighted_out";
+  const SidcRun r = run_sidc("select " + shell_quoted(model) + " --data " + shell_quoted(noisy_record(1e-3)) +
+                             " --require m --folds 0 --out " + shell_quoted(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto weighted = nlohmann::json::parse(read_text(out / "select.json"), nullptr, false);
+  ASSERT_FALSE(weighted.is_discarded());
+  EXPECT_EQ(chosen(weighted), chosen(plain));
+  const auto& a = plain["groups"][0]["sizes"];
+  const auto& b = weighted["groups"][0]["sizes"];
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(b[i]["G"].get<double>(), 4 * a[i]["G"].get<double>(), 1e-9 * (1 + b[i]["G"].get<double>()));
+}
+
 TEST(SelectBinary, DerivativeFormWithoutNoiseFindsTheTrueOperations) {
   const auto j = select_json("candidates_derivative.sid", clean_record(), "--require m");
   ASSERT_FALSE(j.is_discarded());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <set>
 
 #include "compiler/differentiate.hpp"
 #include "compiler/print.hpp"
@@ -545,7 +546,7 @@ std::optional<std::pair<std::string, Span>> foreign_quantity(const Sum& s, const
 // `plot name(y') = fitted against truth`: lowered with the equations' parameters only, split
 // into sum_k a_k op_k + rest like an equation (normalize_pass), and checked to depend on its
 // argument alone, so that it can be drawn over that argument's range.
-std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement& p) {
+std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement& p, const std::set<int>& fitted_parameters) {
   const std::string plot = p.name.name;
   const std::string argument = p.argument.name.name;
   const int order = static_cast<int>(p.argument.primes.size());
@@ -601,7 +602,15 @@ std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement&
     if (parameter < 0) rest.push_back(ir::canonical(std::move(op)));
     else operations[parameter].push_back(ir::canonical(std::move(op)));
   }
-  for (auto& [parameter, terms] : operations) out.terms.push_back({parameter, ir::canonical(std::move(terms))});
+  for (auto& [parameter, terms] : operations) {
+    // Only what the fit estimates can be drawn: a declared parameter no equation uses has no value.
+    if (!fitted_parameters.count(parameter)) {
+      const auto& name = l.decl.model.parameters[static_cast<std::size_t>(parameter)].name;
+      l.diagnostics.add(diag::plot_parameter_not_fitted(terms.front().span.known() ? terms.front().span : where, plot, name));
+      return std::nullopt;
+    }
+    out.terms.push_back({parameter, ir::canonical(std::move(terms))});
+  }
   std::erase_if(out.terms, [](const ir::ParameterTerm& x) { return x.operation.empty(); });
   out.rest = ir::canonical(std::move(rest));
   if (out.terms.empty()) {
@@ -647,8 +656,14 @@ LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Di
     if (auto value = l.lower_in(*declarations.weights, weights))
       declarations.model.weights = ir::WeightExpression{std::move(*value), declarations.weights_span};
   }
+  std::set<int> fitted_parameters;  // the parameters some equation uses
+  for (const auto& e : out.equations)
+    for (const Sum* side : {&e.lhs, &e.rhs})
+      for (const auto& t : side->terms)
+        for (const auto& [f, power] : t.factors)
+          if (f.kind == FactorKind::parameter) fitted_parameters.insert(f.order);
   for (const ast::PlotStatement* p : declarations.plots)
-    if (auto plot = lower_plot(l, *p)) declarations.model.plots.push_back(std::move(*plot));
+    if (auto plot = lower_plot(l, *p, fitted_parameters)) declarations.model.plots.push_back(std::move(*plot));
   out.model = std::move(declarations.model);
   out.model.constants = std::move(l.constants);
   return out;

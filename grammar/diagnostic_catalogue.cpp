@@ -410,6 +410,12 @@ Diagnostic plot_without_parameter(const Span& where, std::string_view plot) {
                "write the function with the equations' parameters, e.g. `plot damper(y') = c1*y' + c2*y'^3`");
 }
 
+Diagnostic plot_parameter_not_fitted(const Span& where, std::string_view plot, std::string_view parameter) {
+  return error("plot-parameter-not-fitted", where,
+               fmt::format("plot `{}` uses parameter `{}`, which no equation uses, so the fit gives it no value", plot, parameter),
+               "draw functions of the parameters the equations estimate");
+}
+
 Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record) {
   return error("operation-not-finite", where,
                fmt::format("`{}`{} is not a finite number at t = {} in `{}`", operation, owner.empty() ? "" : fmt::format(" ({})", owner), time, record),

@@ -134,6 +134,7 @@ Diagnostic plot_argument_not_signal(const Span& where, std::string_view plot, st
 // A plotted function must depend on its argument alone (`quantity`: another signal, t, an integral ...).
 Diagnostic plot_uses_other_quantity(const Span& where, std::string_view plot, std::string_view quantity, std::string_view argument);
 Diagnostic plot_without_parameter(const Span& where, std::string_view plot);
+Diagnostic plot_parameter_not_fitted(const Span& where, std::string_view plot, std::string_view parameter);
 // ---- evaluation on data (runtime/), pointing at the model text
 Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record);
 Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);

@@ -453,7 +453,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
 
 std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                   const FitOptions& options, const FitSummary& summary, std::size_t group,
-                                                  const std::function<bool(std::span<const ResidualRow>)>& rows) {
+                                                  const std::function<bool(std::span<const ResidualRow>)>& rows, std::size_t max_rows) {
   if (group >= summary.groups.size()) return std::nullopt;
   const GroupFit& g = summary.groups[group];
   std::vector<ResidualRow> block;
@@ -475,10 +475,15 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
   const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
   Eigen::MatrixXd A(static_cast<Eigen::Index>(block_rows), p);
   Eigen::VectorXd b(static_cast<Eigen::Index>(block_rows));
-  for (std::size_t r = 0; r < records.size(); ++r) {
+  std::size_t remaining = max_rows;  // rows per equation still wanted
+  for (std::size_t r = 0; r < records.size() && remaining > 0; ++r) {
     auto window = fit_window(records[r], model, options.evaluation, options.from, options.to);
     if (auto* d = std::get_if<Diagnostic>(&window)) return *d;
-    const FitWindow w = std::get<FitWindow>(window);
+    FitWindow w = std::get<FitWindow>(window);
+    // Only the rows wanted are evaluated: the whole-window values (integrals from t0, derivatives
+    // of the whole record) of the first rows do not depend on where the window ends.
+    if (w.size() > remaining) w.last = w.first + remaining - 1;
+    remaining -= w.size();
     std::vector<const ir::Sum*> sums;
     for (std::size_t e : g.equations) {
       for (const auto& term : model.equations[e].terms) sums.push_back(&term.operation);

@@ -104,7 +104,8 @@ struct ResidualRow {
 // rows again block by block for a streamed one (memory independent of n).
 std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                   const FitOptions& options, const FitSummary& summary, std::size_t group,
-                                                  const std::function<bool(std::span<const ResidualRow>)>& rows);
+                                                  const std::function<bool(std::span<const ResidualRow>)>& rows,
+                                                  std::size_t max_rows = static_cast<std::size_t>(-1));
 
 // `set weights = <expression>` (eq. 2-1.6) on the evaluator's fit window: one weight per row, or
 // a Diagnostic at the `set weights` line when a value is negative, NaN or infinite.

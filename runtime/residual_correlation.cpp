@@ -187,7 +187,7 @@ GroupResiduals group_residuals(const ir::Model& model, const std::vector<Sampled
       ++rows;
     }
     return true;
-  });
+  }, max_rows == static_cast<std::size_t>(-1) ? max_rows : max_rows + 1);  // one more row tells `truncated`
   if (problem) out.message = problem->message;
   out.ok = out.message.empty();
   return out;

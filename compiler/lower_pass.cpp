@@ -6,6 +6,7 @@
 #include <set>
 
 #include "compiler/differentiate.hpp"
+#include "compiler/parameter_split.hpp"
 #include "compiler/print.hpp"
 #include "compiler/settings.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
@@ -582,27 +583,9 @@ std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement&
   out.signal = argument;
   out.order = order;
   out.truth = std::move(truth);
-  std::map<int, std::vector<Term>> operations;
-  std::vector<Term> rest;
-  for (const auto& t : fitted->terms) {
-    int parameter = -1;
-    Term op{t.coefficient, {}, t.span};
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind != FactorKind::parameter) {
-        op.factors.push_back({f, power});
-        continue;
-      }
-      if (power != 1 || parameter >= 0) {
-        l.diagnostics.add(diag::nonlinear_parameter(t.span, f.name, power != 1 ? fmt::format("it is raised to the power {}", power)
-                                                                                : std::string("it multiplies another parameter")));
-        return std::nullopt;
-      }
-      parameter = f.order;
-    }
-    if (parameter < 0) rest.push_back(ir::canonical(std::move(op)));
-    else operations[parameter].push_back(ir::canonical(std::move(op)));
-  }
-  for (auto& [parameter, terms] : operations) {
+  auto split = split_by_parameter(*fitted, l.decl.model, l.diagnostics);
+  if (!split) return std::nullopt;
+  for (auto& [parameter, terms] : split->operations) {
     // Only what the fit estimates can be drawn: a declared parameter no equation uses has no value.
     if (!fitted_parameters.count(parameter)) {
       const auto& name = l.decl.model.parameters[static_cast<std::size_t>(parameter)].name;
@@ -612,7 +595,7 @@ std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement&
     out.terms.push_back({parameter, ir::canonical(std::move(terms))});
   }
   std::erase_if(out.terms, [](const ir::ParameterTerm& x) { return x.operation.empty(); });
-  out.rest = ir::canonical(std::move(rest));
+  out.rest = ir::canonical(std::move(split->rest));
   if (out.terms.empty()) {
     l.diagnostics.add(diag::plot_without_parameter(where, plot));
     return std::nullopt;

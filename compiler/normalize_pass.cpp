@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <map>
 
+#include "compiler/parameter_split.hpp"
 #include "compiler/print.hpp"
 #include "grammar/diagnostic_catalogue.hpp"
 
@@ -59,37 +60,16 @@ ir::Model normalize_pass(LoweredModel lowered, Diagnostics& diagnostics) {
     const bool swap = !has_parameters(e.lhs) && has_parameters(e.rhs);
     const Sum all = swap ? ir::subtract(e.rhs, e.lhs) : ir::subtract(e.lhs, e.rhs);
 
-    std::map<int, std::vector<Term>> operations;  // parameter index -> terms it multiplies
-    std::vector<Term> known;
-    bool ok = true;
-    for (const auto& t : all.terms) {
-      int parameter = -1;
-      Term op{t.coefficient, {}, t.span};
-      for (const auto& [f, power] : t.factors) {
-        if (f.kind != FactorKind::parameter) {
-          op.factors.push_back({f, power});
-          continue;
-        }
-        if (power != 1) {
-          diagnostics.add(diag::nonlinear_parameter(t.span, f.name, fmt::format("it is raised to the power {}", power)));
-          ok = false;
-        } else if (parameter >= 0) {
-          diagnostics.add(diag::nonlinear_parameter(t.span, f.name,
-                                                    fmt::format("it multiplies parameter `{}`", model.parameters[static_cast<std::size_t>(parameter)].name)));
-          ok = false;
-        }
-        parameter = f.order;
-      }
-      if (parameter < 0) known.push_back(ir::negate(ir::canonical(std::vector<Term>{op})).terms.front());
-      else operations[parameter].push_back(ir::canonical(std::move(op)));
-    }
-    if (!ok) continue;
+    auto split = split_by_parameter(all, model, diagnostics);
+    if (!split) continue;
 
     ir::Equation eq;
     eq.span = e.span;
     eq.integration = e.integration;
+    std::vector<Term> known;  // the parameter-free terms, on the other side
+    for (const auto& t : split->rest) known.push_back(ir::negate(ir::canonical(std::vector<Term>{t})).terms.front());
     eq.known = ir::canonical(std::move(known));
-    for (auto& [parameter, terms] : operations) eq.terms.push_back({parameter, ir::canonical(std::move(terms))});
+    for (auto& [parameter, terms] : split->operations) eq.terms.push_back({parameter, ir::canonical(std::move(terms))});
     std::erase_if(eq.terms, [](const ir::ParameterTerm& p) { return p.operation.empty(); });  // a1*y - a1*y
 
     if (eq.terms.empty()) {

@@ -249,18 +249,7 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
         if (auto* d = std::get_if<Diagnostic>(&lhs)) return *d;
         auto rhs = sum(*c.rhs, r);
         if (auto* d = std::get_if<Diagnostic>(&rhs)) return *d;
-        const Values& l = std::get<Values>(lhs);
-        const Values& rv = std::get<Values>(rhs);
-        for (std::size_t i = 0; i < n; ++i) {
-          if (std::isnan(l[i]) || std::isnan(rv[i])) {
-            v[i] = nan;
-            continue;
-          }
-          const bool holds = c.relation == ir::Relation::less ? l[i] < rv[i]
-                           : c.relation == ir::Relation::less_equal ? l[i] <= rv[i]
-                           : c.relation == ir::Relation::greater ? l[i] > rv[i] : l[i] >= rv[i];
-          if (!holds) v[i] = 0.0;
-        }
+        apply_condition(c.relation, std::get<Values>(lhs), std::get<Values>(rhs), v);
       }
       return v;
     }

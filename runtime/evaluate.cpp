@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 
 #include "compiler/integrate_pass.hpp"
@@ -23,6 +24,20 @@ std::size_t index_at_or_after(const std::vector<double>& time, double t) {
 }
 
 }  // namespace
+
+void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < guard.size(); ++i) {
+    if (std::isnan(lhs[i]) || std::isnan(rhs[i])) {
+      guard[i] = nan;
+      continue;
+    }
+    const bool holds = relation == ir::Relation::less ? lhs[i] < rhs[i]
+                     : relation == ir::Relation::less_equal ? lhs[i] <= rhs[i]
+                     : relation == ir::Relation::greater ? lhs[i] > rhs[i] : lhs[i] >= rhs[i];
+    if (!holds) guard[i] = 0.0;
+  }
+}
 
 int highest_derivative_order(const ir::Model& model) {
   int k = 0;
@@ -163,18 +178,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
         if (auto* d = std::get_if<Diagnostic>(&lhs)) return *d;
         auto rhs = evaluate(*c.rhs);
         if (auto* d = std::get_if<Diagnostic>(&rhs)) return *d;
-        const Values& l = std::get<Values>(lhs);
-        const Values& r = std::get<Values>(rhs);
-        for (std::size_t i = 0; i < n; ++i) {
-          if (std::isnan(l[i]) || std::isnan(r[i])) {
-            v[i] = nan;
-            continue;
-          }
-          const bool holds = c.relation == ir::Relation::less ? l[i] < r[i]
-                           : c.relation == ir::Relation::less_equal ? l[i] <= r[i]
-                           : c.relation == ir::Relation::greater ? l[i] > r[i] : l[i] >= r[i];
-          if (!holds) v[i] = 0.0;
-        }
+        apply_condition(c.relation, std::get<Values>(lhs), std::get<Values>(rhs), v);
       }
       return v;
     }

@@ -11,6 +11,7 @@
 
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <variant>
 #include <vector>
@@ -48,6 +49,11 @@ struct FitWindow {
 // The highest order of derivative any operation of the model estimates (a der() of a derivative
 // adds up); the fit window keeps clear of the samples such derivatives lose at each edge.
 int highest_derivative_order(const ir::Model& model);
+
+// One condition of a guard (eq. 4-1.9's regions) sample by sample: where `lhs relation rhs` fails,
+// `guard` becomes 0; where either side is NaN (no value there), NaN. Shared by the whole-record
+// and block evaluators, so that both draw the regions' borders alike.
+void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard);
 
 // The window the thesis uses: from the first sample with a full neighbourhood for every
 // derivative (t0 = 3*alpha*Delta for the 7-point operator applied alpha times, eq. 4-1.10) to the

@@ -15,15 +15,13 @@
 #include "runtime/block_evaluator.hpp"
 #include "runtime/fit.hpp"
 
+#include "support/shell.hpp"
+
 namespace sidc {
 namespace {
 
-std::string read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+// The file's text (tests/support/shell.hpp).
+std::string read(const std::string& path) { return testing::read_text(path); }
 
 ir::Model compiled_text(const std::string& name, const std::string& text) {
   const auto r = compile(std::make_shared<const SourceFile>(name, text), {});

@@ -29,15 +29,13 @@
 #include "runtime/records.hpp"
 #include "runtime/simulate.hpp"
 
+#include "support/shell.hpp"
+
 namespace sidc {
 namespace {
 
-std::string read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+// The file's text (tests/support/shell.hpp).
+std::string read(const std::string& path) { return testing::read_text(path); }
 
 struct Rows {
   std::vector<double> t, y;

@@ -11,15 +11,13 @@
 #include "process_record.hpp"
 #include "runtime/fit.hpp"
 
+#include "support/shell.hpp"
+
 namespace sidc {
 namespace {
 
-std::string read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+// The file's text (tests/support/shell.hpp).
+std::string read(const std::string& path) { return testing::read_text(path); }
 
 SampledRecord as_sampled(const thesis::ProcessRecord& r) {
   SampledRecord s;

@@ -414,6 +414,9 @@ RenderSummary render_figure(const Figure& figure, const std::string& directory, 
   if (options.png) {
     if (!replace_file(png_temporary, png_final, &why)) {
       cleanup();
+      // Both or neither: an SVG without its PNG is half a figure.
+      for (const auto& file : summary.files) std::remove(file.c_str());
+      summary.files.clear();
       summary.status = Status::io_error;
       summary.message = why;
       return summary;

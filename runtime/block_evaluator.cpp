@@ -218,12 +218,7 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       auto argument = sum(*f.argument, r);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
       Values v = std::get<Values>(std::move(argument));
-      const std::string& name = f.name;
-      for (double& x : v) {
-        x = name == "sin" ? std::sin(x) : name == "cos" ? std::cos(x) : name == "exp" ? std::exp(x)
-          : name == "log" ? std::log(x) : name == "sqrt" ? std::sqrt(x) : name == "abs" ? std::abs(x)
-          : name == "tanh" ? std::tanh(x) : (std::isnan(x) ? x : static_cast<double>((x > 0) - (x < 0)));
-      }
+      apply_function(f.name, v);
       return v;
     }
     case FactorKind::power: {

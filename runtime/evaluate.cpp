@@ -39,6 +39,22 @@ void apply_condition(ir::Relation relation, std::span<const double> lhs, std::sp
   }
 }
 
+void apply_function(const std::string& name, std::span<double> values) {
+  // A loop per function rather than a name comparison per sample (std:: functions may not be
+  // taken by address, so each gets its own loop).
+  auto each = [&](auto f) {
+    for (double& x : values) x = f(x);
+  };
+  if (name == "sin") each([](double x) { return std::sin(x); });
+  else if (name == "cos") each([](double x) { return std::cos(x); });
+  else if (name == "exp") each([](double x) { return std::exp(x); });
+  else if (name == "log") each([](double x) { return std::log(x); });
+  else if (name == "sqrt") each([](double x) { return std::sqrt(x); });
+  else if (name == "abs") each([](double x) { return std::abs(x); });
+  else if (name == "tanh") each([](double x) { return std::tanh(x); });
+  else each([](double x) { return std::isnan(x) ? x : static_cast<double>((x > 0) - (x < 0)); });  // sign
+}
+
 int highest_derivative_order(const ir::Model& model) {
   int k = 0;
   for (const auto& e : model.equations) k = std::max(k, derivative_burden(e));
@@ -133,12 +149,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
       auto argument = evaluate(*f.argument);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
       Values v = std::get<Values>(std::move(argument));
-      const std::string& name = f.name;
-      for (double& x : v) {
-        x = name == "sin" ? std::sin(x) : name == "cos" ? std::cos(x) : name == "exp" ? std::exp(x)
-          : name == "log" ? std::log(x) : name == "sqrt" ? std::sqrt(x) : name == "abs" ? std::abs(x)
-          : name == "tanh" ? std::tanh(x) : (std::isnan(x) ? x : static_cast<double>((x > 0) - (x < 0)));
-      }
+      apply_function(f.name, v);
       return v;
     }
     case FactorKind::power: {

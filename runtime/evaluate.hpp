@@ -55,6 +55,10 @@ int highest_derivative_order(const ir::Model& model);
 // and block evaluators, so that both draw the regions' borders alike.
 void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard);
 
+// One of the language's functions (sin, cos, exp, log, sqrt, abs, sign, tanh) applied in place;
+// the name is resolved once, not per sample. Shared by the whole-record and block evaluators.
+void apply_function(const std::string& name, std::span<double> values);
+
 // The window the thesis uses: from the first sample with a full neighbourhood for every
 // derivative (t0 = 3*alpha*Delta for the 7-point operator applied alpha times, eq. 4-1.10) to the
 // last, cut to [from, to] when given. A Diagnostic when nothing is left.

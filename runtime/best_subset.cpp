@@ -191,15 +191,11 @@ bool BestSubsetOptions::is_valid(int p, std::string* why) const {
 BestSubsetSummary best_subsets(const TriangularSystem& system, const BestSubsetOptions& options) {
   BestSubsetSummary summary;
   const auto p = static_cast<int>(system.R.cols());
-  if (system.R.rows() != p || system.z.size() != p) {
-    summary.message = fmt::format("the triangle is {} x {} with {} right-hand sides", system.R.rows(), system.R.cols(), system.z.size());
+  if (auto why = triangle_problem(system)) {
+    summary.message = *why;
     return summary;
   }
   if (!options.is_valid(p, &summary.message)) return summary;
-  if (!system.R.allFinite() || !system.z.allFinite() || !std::isfinite(system.residual_sum_of_squares)) {
-    summary.message = "the triangle has a NaN or infinite entry";
-    return summary;
-  }
 
   // Units: groups, then single columns; required units first (they are never dropped).
   std::vector<int> unit_of(static_cast<std::size_t>(p), -1);

@@ -51,11 +51,11 @@ double projection(const std::vector<Eigen::VectorXd>& basis, const Eigen::Matrix
 ForwardRegressionSummary forward_regression(const TriangularSystem& system, const ForwardRegressionOptions& options) {
   ForwardRegressionSummary summary;
   const auto p = static_cast<int>(system.R.cols());
-  if (!options.is_valid(p, &summary.message)) return summary;
-  if (!system.R.allFinite() || !system.z.allFinite()) {
-    summary.message = "the triangle has a NaN or infinite entry";
+  if (auto why = triangle_problem(system)) {
+    summary.message = *why;
     return summary;
   }
+  if (!options.is_valid(p, &summary.message)) return summary;
   const Eigen::MatrixXd R = system.R.triangularView<Eigen::Upper>();
   summary.G_empty = system.z.squaredNorm() + system.residual_sum_of_squares;
   const double G0 = summary.G_empty > 0 ? summary.G_empty : 1.0;

@@ -730,6 +730,16 @@ LeastSquaresSummary solve_least_squares(const Eigen::MatrixXd& A, const Eigen::V
   return solve_rows(Rows{A, b, weights}, column_names, options, nullptr);
 }
 
+std::optional<std::string> triangle_problem(const TriangularSystem& system) {
+  const auto p = system.R.cols();
+  if (system.R.rows() != p || system.z.size() != p)
+    return fmt::format("the triangle is {} x {} with {} right-hand sides", system.R.rows(), p, system.z.size());
+  if (!system.R.allFinite() || !system.z.allFinite() || !std::isfinite(system.residual_sum_of_squares))
+    return std::string("the triangle has a NaN or infinite entry");
+  if (system.residual_sum_of_squares < 0) return std::string("the triangle's residual sum of squares is negative");
+  return std::nullopt;
+}
+
 LeastSquaresSummary solve_least_squares(const TriangularSystem& system,
                                         const std::vector<std::string>& column_names,
                                         const LeastSquaresOptions& options) {

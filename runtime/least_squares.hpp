@@ -34,6 +34,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -180,6 +181,11 @@ struct TriangularSystem {
   double total_sum_of_squares_centred = 0;    // sum w_i^2 (b_i - ybar_w)^2
   double total_sum_of_squares_uncentred = 0;  // sum (w_i b_i)^2
 };
+
+// Why a TriangularSystem cannot be searched or solved: R not p x p, z not of size p, or a NaN,
+// infinite or negative entry where none may be; nullopt when it is sound. The checks every
+// selection method (best_subset, sequential_threshold, forward_regression) starts with.
+std::optional<std::string> triangle_problem(const TriangularSystem& system);
 
 // Solves a TriangularSystem with the same options, pivoting, rank decision, refinement (against
 // R and z) and statistics as solve_least_squares; R^2 is 1 - G / TSS here and residuals are empty.

@@ -32,11 +32,11 @@ bool SequentialThresholdOptions::is_valid(int p, std::string* why) const {
 SequentialThresholdSummary sequential_threshold(const TriangularSystem& system, const SequentialThresholdOptions& options) {
   SequentialThresholdSummary summary;
   const auto p = static_cast<int>(system.R.cols());
-  if (!options.is_valid(p, &summary.message)) return summary;
-  if (!system.R.allFinite() || !system.z.allFinite()) {
-    summary.message = "the triangle has a NaN or infinite entry";
+  if (auto why = triangle_problem(system)) {
+    summary.message = *why;
     return summary;
   }
+  if (!options.is_valid(p, &summary.message)) return summary;
   const Eigen::MatrixXd R = system.R.triangularView<Eigen::Upper>();
   const double norm_b = std::sqrt(system.z.squaredNorm() + system.residual_sum_of_squares);
   std::vector<int> unit_of(static_cast<std::size_t>(p), -1);

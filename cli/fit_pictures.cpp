@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <map>
+#include <memory>
 
 #include "compiler/print.hpp"
 #include "report/fit_figures.hpp"
@@ -39,29 +40,40 @@ std::vector<double> parameter_values(const ir::Model& model, const FitSummary& s
 struct WindowValues {
   std::vector<double> time, values;
 };
-std::optional<WindowValues> estimated(const SampledRecord& record, const ir::Model& model, const FitOptions& options,
-                                      const std::string& signal, int order) {
-  auto window = fit_window(record, model, options.evaluation, options.from, options.to);
-  if (!std::holds_alternative<FitWindow>(window)) return std::nullopt;
-  const FitWindow w = std::get<FitWindow>(window);
-  Evaluator evaluator(record, model, options.evaluation, w);
-  ir::Factor f{ir::FactorKind::signal, signal, order, {}, {}, {}, {}};
-  auto all = evaluator.evaluate(ir::factor(f));
-  if (!std::holds_alternative<std::vector<double>>(all)) return std::nullopt;
-  const auto& v = std::get<std::vector<double>>(all);
-  WindowValues out;
-  for (std::size_t k = w.first; k <= w.last && k < v.size(); ++k) {
-    out.time.push_back(record.time[k]);
-    out.values.push_back(v[k]);
+
+// One record's estimates, through one Evaluator: it keeps each derivative it has estimated, so a
+// derivative drawn in several figures (a plot's range, the phase plane, the derivative errors) is
+// estimated once.
+class WindowEstimates {
+ public:
+  WindowEstimates(const SampledRecord& record, const ir::Model& model, const FitOptions& options) : record_(record) {
+    auto window = fit_window(record, model, options.evaluation, options.from, options.to);
+    if (auto* w = std::get_if<FitWindow>(&window)) evaluator_ = std::make_unique<Evaluator>(record, model, options.evaluation, *w);
   }
-  return out;
-}
+
+  std::optional<WindowValues> of(const std::string& signal, int order) {
+    if (!evaluator_) return std::nullopt;
+    ir::Factor f{ir::FactorKind::signal, signal, order, {}, {}, {}, {}};
+    auto all = evaluator_->evaluate(ir::factor(f));
+    if (!std::holds_alternative<std::vector<double>>(all)) return std::nullopt;
+    const auto& v = std::get<std::vector<double>>(all);
+    const FitWindow& w = evaluator_->window();
+    WindowValues out;
+    for (std::size_t k = w.first; k <= w.last && k < v.size(); ++k) {
+      out.time.push_back(record_.time[k]);
+      out.values.push_back(v[k]);
+    }
+    return out;
+  }
+
+ private:
+  const SampledRecord& record_;
+  std::unique_ptr<Evaluator> evaluator_;  // null when the record has no fit window
+};
 
 // An exact derivative recorded in the file beside the output (`y' = "ydot"`), at the times of `at`.
-std::optional<std::vector<double>> exact_column(const ir::DataSource& source, const std::string& column, const std::vector<double>& at) {
-  auto read = read_csv(source.path);
-  if (!std::holds_alternative<Record>(read)) return std::nullopt;
-  const Record& r = std::get<Record>(read);
+std::optional<std::vector<double>> exact_column(const Record& r, const ir::DataSource& source, const std::string& column,
+                                                const std::vector<double>& at) {
   std::string time_name = "t";
   for (const auto& [signal, col] : source.bindings)
     if (signal == "t") time_name = col;
@@ -129,12 +141,15 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
     }
   }
 
+  std::vector<std::unique_ptr<WindowEstimates>> per_record;
+  for (const auto& record : c.records) per_record.push_back(std::make_unique<WindowEstimates>(record, model, c.options));
+
   // Figs. 4-1.13/4-1.14: each plotted function over the range its argument covers in the records.
   const std::vector<double> values = parameter_values(normalized, c.summary);
   for (const auto& plot : normalized.plots) {
     double low = INFINITY, high = -INFINITY;
-    for (const auto& record : c.records)
-      if (auto w = estimated(record, model, c.options, plot.signal, plot.order))
+    for (auto& estimates : per_record)
+      if (auto w = estimates->of(plot.signal, plot.order))
         for (double x : w->values)
           if (std::isfinite(x)) low = std::min(low, x), high = std::max(high, x);
     if (!(low < high)) continue;
@@ -149,14 +164,18 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
 
   for (std::size_t r = 0; r < c.records.size(); ++r) {
     const SampledRecord& record = c.records[r];
-    // Figs. 4-1.8/4-1.9: the moving-arc estimates against the exact derivatives the file records.
-    if (r < c.sources.size()) {
+    WindowEstimates& estimates = *per_record[r];
+    // Figs. 4-1.8/4-1.9: the moving-arc estimates against the exact derivatives the file records
+    // (the file is read again once: the fit kept only the columns it binds).
+    if (r < c.sources.size() && !c.sources[r].exact_derivatives.empty()) {
+      auto read = read_csv(c.sources[r].path);
       std::map<std::string, std::vector<DerivativeComparison>> by_signal;
       std::vector<double> at;
       for (const auto& exact : c.sources[r].exact_derivatives) {
-        auto w = estimated(record, model, c.options, exact.signal, exact.order);
+        if (!std::holds_alternative<Record>(read)) break;
+        auto w = estimates.of(exact.signal, exact.order);
         if (!w) continue;
-        auto truth = exact_column(c.sources[r], exact.column, w->time);
+        auto truth = exact_column(std::get<Record>(read), c.sources[r], exact.column, w->time);
         if (!truth) continue;
         at = w->time;
         by_signal[exact.signal].push_back({exact.order, w->values, *truth});
@@ -172,8 +191,8 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
     // Fig. 4-1.7: the phase plane of each output of a second (or higher) order equation.
     for (const auto& s : model.signals) {
       if (s.kind != ir::Signal::Kind::output || order_of(normalized, s.name) < 2) continue;
-      auto y = estimated(record, model, c.options, s.name, 0);
-      auto y_dot = estimated(record, model, c.options, s.name, 1);
+      auto y = estimates.of(s.name, 0);
+      auto y_dot = estimates.of(s.name, 1);
       if (!y || !y_dot) continue;
       Figure f = phase_plane_figure({s.name, ""}, "s", y->values, y_dot->values);
       f.name += suffix(r);

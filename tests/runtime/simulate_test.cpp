@@ -146,13 +146,19 @@ const char* kThesis =
     "m*y'' + cn*y'*[y' <= 0] + cn3*y'^3*[y' <= 0] + cp*y'*[y' > 0] + cp3*y'^3*[y' > 0] + k*y + k2*y^2 = x\n";
 const std::vector<double> kThesisParameters = {0.051813, 0.5, 0.0025, 1, 0.01, 30, -3};
 
-TEST(Simulate, GuardSwitchesAreLocatedSoRk4KeepsItsOrder) {
-  const ir::Model m = normalized(kThesis);
-  const ExplicitForm f = form_of(m);
+// The thesis' run: its values, y(0) = y'(0) = 0 (eq. 4-1.3), one second sampled every 0.01 s.
+SimulateOptions thesis_run() {
   SimulateOptions o;
   o.parameters = kThesisParameters;
   o.initial["y"] = {0, 0};
   o.time = grid(0, 1, 0.01);
+  return o;
+}
+
+TEST(Simulate, GuardSwitchesAreLocatedSoRk4KeepsItsOrder) {
+  const ir::Model m = normalized(kThesis);
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o = thesis_run();
   o.method = SimulateOptions::Method::adaptive;
   o.absolute_tolerance = o.relative_tolerance = 1e-13;
   const auto reference = run(m, f, o);
@@ -238,10 +244,7 @@ TEST(Simulate, CoupledOutputsSolvedTogether) {
 TEST(Validate, ReproducesItsOwnRecordAndReportsDivergence) {
   const ir::Model m = normalized(kThesis);
   const ExplicitForm f = form_of(m);
-  SimulateOptions o;
-  o.parameters = kThesisParameters;
-  o.initial["y"] = {0, 0};
-  o.time = grid(0, 1, 0.01);
+  SimulateOptions o = thesis_run();
   o.substeps = 10;
   const auto truth = run(m, f, o);
   SampledRecord record;

@@ -22,13 +22,19 @@ namespace fs = std::filesystem;
 using sidc::testing::read_text;
 using sidc::testing::shell_quoted;
 
-TEST(ThesisPictures, EveryFigureIsDrawnAndTheReportEmbedsThem) {
-  const fs::path work = fs::path(SIDC_THESIS_WORK_DIR) / "pictures";
+// A fresh work folder holding the example's model and record, as a user has them.
+fs::path example_copy(const std::string& name) {
+  const fs::path work = fs::path(SIDC_THESIS_WORK_DIR) / name;
   fs::remove_all(work);
   fs::create_directories(work);
   const fs::path examples(SIDC_THESIS_EXAMPLE_DIR);
   fs::copy_file(examples / "appendix_a.csv", work / "appendix_a.csv");
   fs::copy_file(examples / "quasi_linear.sid", work / "quasi_linear.sid");
+  return work;
+}
+
+TEST(ThesisPictures, EveryFigureIsDrawnAndTheReportEmbedsThem) {
+  const fs::path work = example_copy("pictures");
   const fs::path pictures = work / "pictures", report = work / "report.html", log = work / "fit.log";
   const std::string command = "cd " + shell_quoted(work) + " && " + shell_quoted(SIDC_BINARY) + " fit quasi_linear.sid --plots " +
                               shell_quoted(pictures) + " --report " + shell_quoted(report) + " >" + shell_quoted(log) + " 2>&1";
@@ -62,12 +68,7 @@ TEST(ThesisPictures, EveryFigureIsDrawnAndTheReportEmbedsThem) {
 }
 
 TEST(ThesisPictures, AFailingFigureLeavesNoReportBehind) {
-  const fs::path work = fs::path(SIDC_THESIS_WORK_DIR) / "pictures_unwritable";
-  fs::remove_all(work);
-  fs::create_directories(work);
-  const fs::path examples(SIDC_THESIS_EXAMPLE_DIR);
-  fs::copy_file(examples / "appendix_a.csv", work / "appendix_a.csv");
-  fs::copy_file(examples / "quasi_linear.sid", work / "quasi_linear.sid");
+  const fs::path work = example_copy("pictures_unwritable");
   // --plots names a regular file: the folder cannot be made.
   { std::ofstream(work / "taken") << "x"; }
   const fs::path log = work / "fit.log";

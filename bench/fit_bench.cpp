@@ -46,12 +46,12 @@
 #include <fmt/format.h>
 
 #include "compiler/pipeline.hpp"
-#include "compiler/settings.hpp"
-#include "runtime/bind_record.hpp"
-#include "runtime/evaluate.hpp"
-#include "runtime/fit.hpp"
-#include "runtime/least_squares.hpp"
-#include "runtime/records.hpp"
+#include "ir/settings.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/operators/evaluate.hpp"
+#include "runtime/solve/fit.hpp"
+#include "runtime/solve/least_squares.hpp"
+#include "runtime/records/records.hpp"
 
 #ifndef SIDC_BINARY
 #define SIDC_BINARY "sidc"
@@ -395,7 +395,7 @@ PathTotals run_library(const fs::path& model_path, const fs::path& csv_path, std
   // bench frees it here, which flatters the later RSS figures slightly, not the peak.
   record.reset();
 
-  // The fit exactly as `sidc fit` runs it: runtime/fit.cpp's fit() with the model's settings. At
+  // The fit exactly as `sidc fit` runs it: runtime/solve/fit.cpp's fit() with the model's settings. At
   // these sizes it streams: row blocks evaluated and folded into the triangular factor on every
   // core; its own clocks split the time into evaluation, folding and the final p x p solve.
   const EvaluationOptions evaluation = evaluation_options(*model);

@@ -2,7 +2,7 @@
 // time does not depend on the number of rows n. Not a test: run it by hand (bench/README.md,
 // section "select_bench").
 //
-// Relies on: runtime/triangular_accumulator.hpp (rows -> triangle), runtime/best_subset.hpp (the
+// Relies on: runtime/solve/triangular_accumulator.hpp (rows -> triangle), runtime/select/best_subset.hpp (the
 // search). Guarantees: for each n (default 10^4 and 10^6) and each response, the rows are
 // generated here (seeded, so every run sees the same numbers), folded into one triangle (timed:
 // this is the only phase that grows with n), and searched (timed: must not grow with n). Three
@@ -26,8 +26,8 @@
 #include <Eigen/Core>
 #include <fmt/format.h>
 
-#include "runtime/best_subset.hpp"
-#include "runtime/triangular_accumulator.hpp"
+#include "runtime/select/best_subset.hpp"
+#include "runtime/solve/triangular_accumulator.hpp"
 
 namespace {
 

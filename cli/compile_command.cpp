@@ -9,11 +9,12 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/read_file.hpp"
-#include "compiler/compiled_model.hpp"
+#include "report/atomic_file.hpp"
+#include "ir/compiled_model.hpp"
 #include "compiler/pipeline.hpp"
-#include "compiler/print.hpp"
+#include "ir/print.hpp"
 #include "grammar/ast_printer.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
 namespace {
@@ -121,9 +122,9 @@ int run_compile(const CompileArguments& a) {
   for (auto& d : written.data)
     if (std::filesystem::path(d.path).is_relative())
       d.path = (model_dir / d.path).lexically_normal().lexically_relative(output_dir).string();
-  const std::string json = to_json(CompiledModel{source, *r.normalized, written}).dump(1) + "\n";
-  if (!write_file_atomically(output, json, error)) {
-    std::cerr << error << "\nhint: choose a writable place with `-o FILE`\n";
+  const std::string json = to_json(CompiledModel{source, *r.normalized, written, std::nullopt}).dump(1) + "\n";
+  if (!write_file_atomically(output, json, &error)) {
+    std::cerr << "error: " << error << "\nhint: choose a writable place with `-o FILE`\n";
     return exit_code::user_error;
   }
   std::cerr << "wrote " << output << "\n";

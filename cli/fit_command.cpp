@@ -10,16 +10,16 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/read_file.hpp"
-#include "compiler/compiled_model.hpp"
+#include "report/atomic_file.hpp"
+#include "ir/compiled_model.hpp"
 #include "compiler/pipeline.hpp"
-#include "compiler/print.hpp"
-#include "compiler/settings.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
-#include "runtime/bind_record.hpp"
-#include "compiler/explicit_form.hpp"
-#include "runtime/fit.hpp"
-#include "runtime/validate.hpp"
-#include "cli/fit_pictures.hpp"
+#include "ir/print.hpp"
+#include "ir/settings.hpp"
+#include "diagnostics/model_catalogue.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/solve/fit.hpp"
+#include "runtime/simulate/validate.hpp"
+#include "report/fit_pictures.hpp"
 #include "cli/record_options.hpp"
 
 namespace sidc {
@@ -68,14 +68,14 @@ std::optional<CompiledModel> load_compiled_model(const std::string& path, std::s
       return std::nullopt;
     }
     std::cerr << r.diagnostics.render_all();  // warnings
-    return CompiledModel{source, *r.normalized, *r.integrated};
+    return compiled_model(source, *r.normalized, *r.integrated);
   }
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(*text, nullptr, false);
   if (j.is_discarded()) {
     error = fmt::format("error: `{}` is not JSON; compile the model again with `sidc compile`", path);
     return std::nullopt;
   }
-  auto compiled = compiled_model_from_json(j, path, error);
+  auto compiled = read_compiled_model(j, path, error);
   if (!compiled) return std::nullopt;
   // A model file changed since it was compiled makes a stale fit: say so.
   const fs::path source = fs::path(path).parent_path() / fs::path(compiled->source->name).filename();
@@ -133,7 +133,7 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
 }
 
 // residuals.csv, written as the rows come: a streamed fit evaluates them again block by block
-// (runtime/fit.hpp, for_each_residual_block), so the file never has to be held in memory.
+// (runtime/solve/fit.hpp, for_each_residual_block), so the file never has to be held in memory.
 bool write_residuals(std::ostream& out, const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
                      const FitSummary& s, std::string& problem) {
   out << "group,equation,record,t,known,fitted,residual\n";
@@ -173,7 +173,7 @@ Validation validate_fit(const CompiledModel& compiled, const FitSummary& summary
     return v;
   }
   const ir::Model& model = compiled.normalized;
-  auto form = explicit_form(model);
+  const auto& form = *compiled.explicit_form;
   if (auto* d = std::get_if<Diagnostic>(&form)) {
     v.note = "skipped: " + d->message;
     return v;
@@ -320,10 +320,11 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     const std::string validation_path = (fs::path(out_dir) / "validation.csv").string();
     const bool curves = validation && !validation->runs.empty();
     std::string problem;  // why residuals.csv could not be written, when the rows could not be had
-    if (ec || !write_file_atomically(json_path, json.dump(1) + "\n", error) ||
-        !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, records, *options, summary, problem); }, error) ||
-        (curves && !write_file_atomically(validation_path, validation_csv(*validation), error))) {
+    if (ec || !write_file_atomically(json_path, json.dump(1) + "\n", &error) ||
+        !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, records, *options, summary, problem); }, &error) ||
+        (curves && !write_file_atomically(validation_path, validation_csv(*validation), &error))) {
       if (!problem.empty()) error = problem;
+      else if (!error.empty()) error = "error: " + error;
       // No half set of files: a fit.json without its residuals.csv would read as complete.
       std::error_code ignored;
       for (const auto& path : {json_path, csv_path, validation_path}) fs::remove(path, ignored);

@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "compiler/compiled_model.hpp"
+#include "ir/compiled_model.hpp"
 
 namespace sidc {
 

@@ -1,7 +1,6 @@
 #include "cli/read_file.hpp"
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
@@ -24,31 +23,6 @@ std::optional<std::string> read_whole_file(const std::string& path, std::string&
   std::ostringstream contents;
   contents << in.rdbuf();
   return std::move(contents).str();
-}
-
-bool write_file_atomically(const std::string& path, const std::function<bool(std::ostream&)>& write, std::string& error) {
-  const std::string temporary = path + ".partial";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out || !write(out) || !(out.flush())) {
-      error = fmt::format("error: cannot write `{}`: {}", path, std::strerror(errno));
-      out.close();
-      std::remove(temporary.c_str());
-      return false;
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    error = fmt::format("error: cannot write `{}`: {}", path, ec.message());
-    std::remove(temporary.c_str());
-    return false;
-  }
-  return true;
-}
-
-bool write_file_atomically(const std::string& path, const std::string& contents, std::string& error) {
-  return write_file_atomically(path, [&](std::ostream& out) { return static_cast<bool>(out << contents); }, error);
 }
 
 }  // namespace sidc

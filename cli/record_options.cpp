@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <fmt/format.h>
 
-#include "compiler/settings.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
-#include "runtime/records.hpp"
+#include "ir/settings.hpp"
+#include "diagnostics/model_catalogue.hpp"
+#include "runtime/records/records.hpp"
 
 namespace sidc {
 namespace fs = std::filesystem;

@@ -1,7 +1,7 @@
 // What `sidc fit` and `sidc select` share: the options that say which records to read and how to
 // evaluate the model on them, turned into FitOptions and bound SampledRecords the same way for both.
 //
-// Relies on: the model's settings (compiler/settings.hpp), which the options override one by one.
+// Relies on: the model's settings (ir/settings.hpp), which the options override one by one.
 // Guarantees: the records are the command line's `--data` files (bound as the model's first data
 // statement), else the model's data statements, with relative paths taken from the compiled
 // model's folder; every problem comes back as a message for stderr and an exit code, never an
@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "compiler/compiled_model.hpp"
-#include "runtime/bind_record.hpp"
-#include "runtime/fit.hpp"
+#include "ir/compiled_model.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/solve/fit.hpp"
 
 namespace sidc {
 

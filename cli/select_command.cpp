@@ -1,7 +1,7 @@
 // `sidc select` (see select_command.hpp).
 //
 // Relies on: cli/fit_command.hpp (load_compiled_model), cli/record_options.hpp (the records and
-// evaluation options, shared with sidc fit), runtime/select.hpp, runtime/validate.hpp (--simulate).
+// evaluation options, shared with sidc fit), runtime/select/select.hpp, runtime/simulate/validate.hpp (--simulate).
 // Guarantees: every bad option is a usage error (exit 2) naming the option, with did-you-mean for
 // parameter names; a bad model or record is a user error (exit 1) rendered as sidc renders
 // diagnostics; nothing is written unless --out is given, and then atomically.
@@ -21,13 +21,14 @@
 #include "cli/exit_codes.hpp"
 #include "cli/fit_command.hpp"
 #include "cli/read_file.hpp"
-#include "compiler/compiled_model.hpp"
-#include "compiler/settings.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
-#include "runtime/bind_record.hpp"
-#include "runtime/records.hpp"
-#include "runtime/select.hpp"
-#include "runtime/validate.hpp"
+#include "report/atomic_file.hpp"
+#include "ir/compiled_model.hpp"
+#include "ir/settings.hpp"
+#include "diagnostics/model_catalogue.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/select/select.hpp"
+#include "runtime/simulate/validate.hpp"
 
 namespace sidc {
 namespace {
@@ -186,12 +187,12 @@ int run_select(const SelectArguments& a) {
     if (equation_groups(model).size() != 1)
       return usage("error: --simulate ranks the subsets of one equation group, and this model has several\n"
                    "hint: select each group's operations from a model of that group alone");
-    auto explicit_equations = explicit_form(compiled->normalized);
+    const auto& explicit_equations = *compiled->explicit_form;
     if (auto* d = std::get_if<Diagnostic>(&explicit_equations)) {
       std::cerr << render(*d) << "\nhint: --simulate needs equations that can be solved for their highest derivatives\n";
       return exit_code::user_error;
     }
-    form = std::get<ExplicitForm>(std::move(explicit_equations));
+    form = std::get<ExplicitForm>(explicit_equations);
     o.simulation_error = [&](std::size_t, const std::vector<std::string>& subset, const std::vector<double>& values) -> std::optional<double> {
       const ir::Model& derivative_form = compiled->normalized;
       std::vector<double> parameters(derivative_form.parameters.size(), 0.0);
@@ -228,8 +229,8 @@ int run_select(const SelectArguments& a) {
     std::error_code ec;
     fs::create_directories(a.out, ec);
     const std::string path = (fs::path(a.out) / "select.json").string();
-    if (ec || !write_file_atomically(path, select_json(summary, a.model, o).dump(1) + "\n", error)) {
-      std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", a.out, ec.message()) : error) << "\n";
+    if (ec || !write_file_atomically(path, select_json(summary, a.model, o).dump(1) + "\n", &error)) {
+      std::cerr << (error.empty() ? fmt::format("error: cannot create `{}`: {}", a.out, ec.message()) : "error: " + error) << "\n";
       return exit_code::user_error;
     }
     std::cerr << "wrote " << path << "\n";

@@ -1,5 +1,5 @@
 // `sidc select`: determination of operations (thesis section 2-3, issue 6). Parses the command
-// line, loads the model and records as `sidc fit` does, runs runtime/select.hpp and prints a
+// line, loads the model and records as `sidc fit` does, runs runtime/select/select.hpp and prints a
 // Table 4-1.2-style table; `--out DIR` also writes DIR/select.json.
 #pragma once
 

@@ -1,7 +1,7 @@
 // `sidc simulate`: argument parsing and printing only. The model is solved for its highest
-// derivatives by compiler/explicit_form.cpp and integrated by runtime/simulate.cpp.
+// derivatives by compiler/explicit_form_pass.cpp and integrated by runtime/simulate/simulate.cpp.
 //
-// Relies on: cli/fit_command.hpp (loading a model), runtime/bind_record.hpp (a record on its
+// Relies on: cli/fit_command.hpp (loading a model), runtime/records/bind_record.hpp (a record on its
 // uniform grid). Guarantees: every bad option is a one-line `error:` with a `hint:` and exit code 2
 // (command line) or 1 (model, record, numbers); the CSV has the record's column names (the time
 // column and each output's bound column) and is written atomically; a run that diverges still
@@ -18,10 +18,10 @@
 #include "cli/exit_codes.hpp"
 #include "cli/fit_command.hpp"
 #include "cli/read_file.hpp"
-#include "compiler/explicit_form.hpp"
-#include "compiler/settings.hpp"
-#include "runtime/bind_record.hpp"
-#include "runtime/simulate.hpp"
+#include "report/atomic_file.hpp"
+#include "ir/settings.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/simulate/simulate.hpp"
 
 namespace sidc {
 namespace {
@@ -157,7 +157,7 @@ int run_simulate(const SimulateArguments& a) {
   auto compiled = load_compiled_model(a.model, error);
   if (!compiled) return fail(error, exit_code::user_error);
   const ir::Model& model = compiled->normalized;
-  auto form = explicit_form(model);
+  const auto& form = *compiled->explicit_form;
   if (auto* d = std::get_if<Diagnostic>(&form)) return fail(render(*d), exit_code::user_error);
   const ExplicitForm& explicit_ = std::get<ExplicitForm>(form);
 
@@ -280,7 +280,7 @@ int run_simulate(const SimulateArguments& a) {
     std::cout << csv;
     std::cerr << report;
   } else {
-    if (!write_file_atomically(a.out, csv, error)) return fail(error, exit_code::user_error);
+    if (!write_file_atomically(a.out, csv, &error)) return fail("error: " + error, exit_code::user_error);
     std::cout << report << "wrote " << a.out << "\n";
   }
   if (!summary.completed()) {

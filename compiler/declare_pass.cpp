@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <fmt/format.h>
 
-#include "compiler/settings.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "ir/settings.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
 

@@ -4,10 +4,11 @@
 #include <stdexcept>
 #include <fmt/format.h>
 
-#include "compiler/differentiate.hpp"
+#include "ir/differentiate.hpp"
+#include "ir/queries.hpp"
 #include "compiler/lower_pass.hpp"
-#include "compiler/settings.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "ir/settings.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
 namespace {
@@ -20,28 +21,6 @@ using ir::Term;
 Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
 
 // Anything that changes with time: a static equation (a plain regression) has none of these.
-bool is_dynamic(const Sum& s);
-bool is_dynamic(const Factor& f) {
-  switch (f.kind) {
-    case FactorKind::signal: return f.order > 0;
-    case FactorKind::time:
-    case FactorKind::elapsed:
-    case FactorKind::derivative:
-    case FactorKind::integral: return true;
-    case FactorKind::function:
-    case FactorKind::power: return is_dynamic(*f.argument);
-    case FactorKind::guard:
-      return std::any_of(f.conditions.begin(), f.conditions.end(),
-                         [](const ir::Condition& c) { return is_dynamic(*c.lhs) || is_dynamic(*c.rhs); });
-    default: return false;
-  }
-}
-bool is_dynamic(const Sum& s) {
-  return std::any_of(s.terms.begin(), s.terms.end(), [](const Term& t) {
-    return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return is_dynamic(f.first); });
-  });
-}
-
 bool has_guard(const Term& t) {
   return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return f.first.kind == FactorKind::guard; });
 }
@@ -222,21 +201,6 @@ struct Integrator {
 };
 
 }  // namespace
-
-int derivative_burden(const ir::Equation& e) {
-  int b = ir::highest_derivative_order(e.known);
-  for (const auto& p : e.terms) b = std::max(b, ir::highest_derivative_order(p.operation));
-  return b;
-}
-
-bool is_static(const ir::Model& model) {
-  for (const auto& e : model.equations) {
-    if (is_dynamic(e.known)) return false;
-    for (const auto& p : e.terms)
-      if (is_dynamic(p.operation)) return false;
-  }
-  return true;
-}
 
 Sum antiderivative(const Sum& s, bool initial) {
   std::vector<Term> remaining = s.terms, result;

@@ -17,8 +17,9 @@
 
 #include <optional>
 
-#include "compiler/ir.hpp"
-#include "grammar/diagnostic.hpp"
+#include "ir/ir.hpp"
+#include "ir/queries.hpp"
+#include "diagnostics/diagnostic.hpp"
 
 namespace sidc {
 
@@ -32,12 +33,5 @@ ir::Model integrate_pass(ir::Model model, const IntegrateOptions& options, Diagn
 // One integration of a parameter-free sum from t0 to t, constants of integration dropped
 // (`initial` = false) or their values at t0 subtracted (`initial` = true).
 ir::Sum antiderivative(const ir::Sum& s, bool initial);
-
-// The highest derivative order anywhere in the equation, inside integrals and functions too.
-int derivative_burden(const ir::Equation& e);
-
-// True when no equation has a derivative, an integral or the time in it: a static regression such
-// as NIST's `y = b0 + b1*x`, whose records need no time column.
-bool is_static(const ir::Model& model);
 
 }  // namespace sidc

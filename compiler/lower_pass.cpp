@@ -5,11 +5,11 @@
 #include <fmt/format.h>
 #include <set>
 
-#include "compiler/differentiate.hpp"
+#include "ir/differentiate.hpp"
 #include "compiler/parameter_split.hpp"
-#include "compiler/print.hpp"
-#include "compiler/settings.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "ir/print.hpp"
+#include "ir/settings.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
 

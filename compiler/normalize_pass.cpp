@@ -5,8 +5,8 @@
 #include <map>
 
 #include "compiler/parameter_split.hpp"
-#include "compiler/print.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "ir/print.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
 namespace {

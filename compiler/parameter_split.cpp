@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "grammar/diagnostic_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
 

@@ -11,8 +11,8 @@
 #include <optional>
 #include <vector>
 
-#include "compiler/ir.hpp"
-#include "grammar/diagnostic.hpp"
+#include "ir/ir.hpp"
+#include "diagnostics/diagnostic.hpp"
 
 namespace sidc {
 

@@ -4,9 +4,10 @@
 #include "compiler/pipeline.hpp"
 
 #include "compiler/declare_pass.hpp"
+#include "compiler/explicit_form_pass.hpp"
 #include "compiler/lower_pass.hpp"
 #include "compiler/normalize_pass.hpp"
-#include "compiler/print.hpp"
+#include "ir/print.hpp"
 
 namespace sidc {
 
@@ -42,6 +43,18 @@ CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOpt
   r.integrated = integrate_pass(*r.normalized, options.integrate, r.diagnostics);
   stop("integrate");
   return r;
+}
+
+// After the passes: the explicit form (explicit_form_pass.cpp) works on the normalized model, before
+// integration, and its failure is no compile error: a model that cannot be solved can still be fitted.
+CompiledModel compiled_model(std::shared_ptr<const SourceFile> source, const ir::Model& normalized, const ir::Model& integrated) {
+  return CompiledModel{std::move(source), normalized, integrated, explicit_form(normalized)};
+}
+
+std::optional<CompiledModel> read_compiled_model(const nlohmann::ordered_json& j, const std::string& path, std::string& error) {
+  auto compiled = compiled_model_from_json(j, path, error);
+  if (compiled) compiled->explicit_form = explicit_form(compiled->normalized);
+  return compiled;
 }
 
 }  // namespace sidc

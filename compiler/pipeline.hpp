@@ -6,8 +6,11 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "compiler/integrate_pass.hpp"
-#include "compiler/ir.hpp"
+#include "ir/compiled_model.hpp"
+#include "ir/ir.hpp"
 #include "grammar/parse.hpp"
 
 namespace sidc {
@@ -35,5 +38,13 @@ struct CompileResult {
 };
 
 CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOptions& options);
+
+// The compiled model of a successful compile, carrying the explicit form of `normalized`
+// (explicit_form_pass), derived once here for every command that solves the equations.
+CompiledModel compiled_model(std::shared_ptr<const SourceFile> source, const ir::Model& normalized, const ir::Model& integrated);
+
+// A compiled model file read back (ir/compiled_model.hpp), its explicit form derived again (the file
+// does not hold it); nullopt with `error` naming what is wrong.
+std::optional<CompiledModel> read_compiled_model(const nlohmann::ordered_json& j, const std::string& path, std::string& error);
 
 }  // namespace sidc

@@ -30,7 +30,7 @@
 #include "grammar/ast.hpp"
 #include "grammar/ast_adapted.hpp"
 #include "grammar/config.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
 #include "grammar/error_handler.hpp"
 #include "grammar/model.hpp"
 

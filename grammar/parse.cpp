@@ -4,7 +4,7 @@
 // invalid bytes, too deep nesting and overlong statements before X3 sees them), and on the X3
 // grammar (model.hpp, instantiated in model.cpp) to read one statement. Guarantees: no exception
 // leaves parse_model; every statement that fails produces exactly one Diagnostic, worded by
-// grammar/diagnostic_catalogue.hpp, and parsing resumes at the next statement; after
+// diagnostics/model_catalogue.hpp, and parsing resumes at the next statement; after
 // `error_limit` errors a note ends the list. The spans of the statements that parsed are in
 // ParseResult::positions (failed statements leave no entries behind).
 #include "grammar/parse.hpp"
@@ -17,7 +17,7 @@
 #include <string_view>
 
 #include "grammar/config.hpp"
-#include "grammar/diagnostic_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
 #include "grammar/model.hpp"
 #include "grammar/statement_scanner.hpp"
 

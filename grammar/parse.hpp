@@ -9,8 +9,8 @@
 #include <memory>
 
 #include "grammar/ast.hpp"
-#include "grammar/diagnostic.hpp"
-#include "grammar/source.hpp"
+#include "diagnostics/diagnostic.hpp"
+#include "diagnostics/source.hpp"
 
 namespace sidc {
 

@@ -6,12 +6,21 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include <sys/stat.h>
 #include <unistd.h>
 
 namespace sidc {
+namespace {
+
+bool fail(std::string* why, const std::string& destination, const std::string& reason) {
+  if (why) *why = "cannot write `" + destination + "`: " + reason;
+  return false;
+}
+
+}  // namespace
 
 std::string create_temporary_beside(const std::string& destination, std::string* why) {
   const std::filesystem::path path(destination);
@@ -21,10 +30,10 @@ std::string create_temporary_beside(const std::string& destination, std::string*
   buffer.push_back('\0');
   const int fd = ::mkstemp(buffer.data());
   if (fd < 0) {
-    if (why) *why = "cannot create a temporary file beside " + destination + ": " + std::strerror(errno);
+    fail(why, destination, std::strerror(errno));
     return "";
   }
-  // mkstemp makes the file private (0600); a picture or a report is meant to be read by others.
+  // mkstemp makes the file private (0600); a model, a picture or a report is meant to be read by others.
   ::fchmod(fd, 0644);
   ::close(fd);
   return std::string(buffer.data());
@@ -32,26 +41,31 @@ std::string create_temporary_beside(const std::string& destination, std::string*
 
 bool replace_file(const std::string& temporary, const std::string& destination, std::string* why) {
   if (std::rename(temporary.c_str(), destination.c_str()) != 0) {
-    if (why) *why = "cannot rename " + temporary + " to " + destination + ": " + std::strerror(errno);
+    const int error = errno;
     std::remove(temporary.c_str());
-    return false;
+    return fail(why, destination, std::strerror(error));
   }
   return true;
 }
 
-bool write_file_atomically(const std::string& destination, const std::string& content, std::string* why) {
+bool write_file_atomically(const std::string& destination, const std::function<bool(std::ostream&)>& write, std::string* why) {
   const std::string temporary = create_temporary_beside(destination, why);
   if (temporary.empty()) return false;
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
-  bool ok = file != nullptr;
-  if (ok) ok = std::fwrite(content.data(), 1, content.size(), file) == content.size();
-  if (file) ok = (std::fflush(file) == 0) && ok, ok = (std::fclose(file) == 0) && ok;
+  bool ok = false;
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    ok = out && write(out) && out.flush();
+  }
   if (!ok) {
-    if (why) *why = "cannot write " + temporary + ": " + std::strerror(errno);
+    const int error = errno;
     std::remove(temporary.c_str());
-    return false;
+    return fail(why, destination, std::strerror(error));
   }
   return replace_file(temporary, destination, why);
+}
+
+bool write_file_atomically(const std::string& destination, const std::string& content, std::string* why) {
+  return write_file_atomically(destination, [&](std::ostream& out) { return static_cast<bool>(out.write(content.data(), static_cast<std::streamsize>(content.size()))); }, why);
 }
 
 }  // namespace sidc

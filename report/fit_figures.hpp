@@ -3,7 +3,7 @@
 // gnuplot_renderer.hpp draws it. They do not depend on the simulation or validation code: the
 // caller passes the recorded and simulated samples, the estimates and the truths.
 //
-// Relies on: runtime/residual_correlation.hpp (for the correlation figures) and fmt.
+// Relies on: runtime/solve/residual_correlation.hpp (for the correlation figures) and fmt.
 // Guarantees: no builder throws or aborts; mismatched lengths are not checked here (the renderer
 // reports them as an invalid figure). Percentages follow eq. 4-1.5:
 //   %E = max |observed - approximated| / max |observed| * 100,
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "report/figure.hpp"
-#include "runtime/residual_correlation.hpp"
+#include "runtime/solve/residual_correlation.hpp"
 
 namespace sidc {
 

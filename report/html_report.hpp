@@ -2,7 +2,7 @@
 // pictures, ready to attach to an engineering note.
 //
 // Relies on: plain structs the caller fills (from FitSummary, the validation and the rendered
-// figures); runtime/least_squares.hpp only for the convenience group_statistics_from().
+// figures); runtime/solve/least_squares.hpp only for the convenience group_statistics_from().
 //
 // Guarantees:
 // - Self-contained: CSS inline in a <style> element, every picture an inline <svg> element (the
@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "runtime/least_squares.hpp"
+#include "runtime/solve/least_squares.hpp"
 
 namespace sidc {
 

@@ -10,9 +10,9 @@
 #include <random>
 #include <sstream>
 
-#include "compiler/compiled_model.hpp"
+#include "ir/compiled_model.hpp"
 #include "compiler/pipeline.hpp"
-#include "compiler/print.hpp"
+#include "ir/print.hpp"
 
 namespace sidc {
 namespace {
@@ -78,7 +78,7 @@ TEST(CompileMutation, NoMutatedModelMakesTheCompilerThrow) {
           ++compiled_ok;
           // What compiles must print, serialize and read back.
           (void)print(*r.integrated);
-          const auto j = to_json(CompiledModel{source, *r.normalized, *r.integrated});
+          const auto j = to_json(compiled_model(source, *r.normalized, *r.integrated));
           std::string error;
           ASSERT_TRUE(compiled_model_from_json(j, "mutated.sidc.json", error)) << error << "\n" << text;
         } else {

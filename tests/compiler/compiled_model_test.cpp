@@ -1,4 +1,4 @@
-// The compiled model file (compiler/compiled_model.hpp) against its documentation: every golden
+// The compiled model file (ir/compiled_model.hpp) against its documentation: every golden
 // model compiles to JSON that validates against docs/compiled-model.schema.json, compiling twice
 // gives the same bytes, reading a file back and writing it again gives the same JSON, and a
 // broken file is refused with a message rather than a crash.
@@ -18,7 +18,7 @@
 #include <set>
 #include <sstream>
 
-#include "compiler/compiled_model.hpp"
+#include "ir/compiled_model.hpp"
 #include "compiler/pipeline.hpp"
 #include "json_schema.hpp"
 
@@ -111,7 +111,7 @@ std::optional<CompiledModel> compiled(const Case& c) {
   auto source = std::make_shared<const SourceFile>(c.source->name, c.source->text);
   CompileResult r = compile(source, c.options);
   if (!r.ok() || !r.normalized || !r.integrated) return std::nullopt;
-  return CompiledModel{source, *r.normalized, *r.integrated};
+  return compiled_model(source, *r.normalized, *r.integrated);
 }
 
 // The file as `sidc compile` writes it, read as `sidc fit` reads it.

@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
 #include "compile_text.hpp"
-#include "compiler/differentiate.hpp"
-#include "compiler/print.hpp"
+#include "ir/differentiate.hpp"
+#include "ir/print.hpp"
 
 namespace sidc {
 namespace {

@@ -1,12 +1,12 @@
 // compiler/explicit_form: equations solved for each output's highest derivative, structurally.
 // (The numerical check, that the explicit form agrees with the equation it came from, is in
 // tests/runtime/simulate_test.cpp, where the point evaluator lives.)
-#include "compiler/explicit_form.hpp"
+#include "compiler/explicit_form_pass.hpp"
 
 #include <gtest/gtest.h>
 
 #include "compile_text.hpp"
-#include "compiler/print.hpp"
+#include "ir/print.hpp"
 
 namespace sidc {
 namespace {

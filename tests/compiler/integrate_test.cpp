@@ -2,9 +2,9 @@
 #include <gtest/gtest.h>
 
 #include "compile_text.hpp"
-#include "compiler/differentiate.hpp"
+#include "ir/differentiate.hpp"
 #include "compiler/integrate_pass.hpp"
-#include "compiler/print.hpp"
+#include "ir/print.hpp"
 
 namespace sidc {
 namespace {

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "compiler/number.hpp"
+#include "ir/number.hpp"
 
 using sidc::Number;
 

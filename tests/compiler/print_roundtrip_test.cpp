@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "compile_text.hpp"
-#include "compiler/print.hpp"
+#include "ir/print.hpp"
 
 namespace sidc {
 namespace {

@@ -1,7 +1,7 @@
 // Syntax errors: what the message says, where it points, and that one run reports several.
 #include <gtest/gtest.h>
 
-#include "grammar/diagnostic_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
 #include "tests/grammar/parse_text.hpp"
 
 namespace sidc {

@@ -19,8 +19,8 @@
 #include <fmt/format.h>
 
 #include "nist_dataset.hpp"
-#include "runtime/least_squares.hpp"
-#include "runtime/triangular_accumulator.hpp"
+#include "runtime/solve/least_squares.hpp"
+#include "runtime/solve/triangular_accumulator.hpp"
 
 namespace {
 

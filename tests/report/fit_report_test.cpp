@@ -15,8 +15,8 @@
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
 #include "report/html_report.hpp"
-#include "runtime/fit.hpp"
-#include "runtime/residual_correlation.hpp"
+#include "runtime/solve/fit.hpp"
+#include "runtime/solve/residual_correlation.hpp"
 
 namespace sidc {
 namespace {

@@ -21,7 +21,7 @@
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
 #include "report/html_report.hpp"
-#include "runtime/residual_correlation.hpp"
+#include "runtime/solve/residual_correlation.hpp"
 
 namespace sidc {
 namespace {

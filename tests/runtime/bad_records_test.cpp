@@ -8,8 +8,8 @@
 #include <set>
 #include <string>
 
-#include "runtime/records.hpp"
-#include "runtime/sampling.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/records/sampling.hpp"
 
 namespace sidc {
 namespace {

@@ -16,8 +16,8 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "runtime/best_subset.hpp"
-#include "runtime/triangular_accumulator.hpp"
+#include "runtime/select/best_subset.hpp"
+#include "runtime/solve/triangular_accumulator.hpp"
 
 namespace sidc {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "compiler/pipeline.hpp"
-#include "runtime/fit.hpp"
+#include "runtime/solve/fit.hpp"
 
 namespace sidc {
 namespace {

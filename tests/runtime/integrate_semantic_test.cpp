@@ -3,9 +3,9 @@
 // quadrature whenever the original equation holds.
 //
 // Relies on: compile (compiler/pipeline.hpp) for the integrated model, and Evaluator
-// (runtime/evaluate.hpp) with its defaults (7-point cubic moving arc, eq. 3-1.7, edges dropped;
+// (runtime/operators/evaluate.hpp) with its defaults (7-point cubic moving arc, eq. 3-1.7, edges dropped;
 // cumulative Simpson, section 3-2) for the operations' values. The integration constants are
-// fitted here with Eigen, on the residual left by the TRUE parameters; sidc::fit (runtime/fit.hpp)
+// fitted here with Eigen, on the residual left by the TRUE parameters; sidc::fit (runtime/solve/fit.hpp)
 // appears only in the last, end-to-end test.
 //
 // How: y (and a second input where needed) is a sum of sinusoids with random amplitudes,
@@ -54,9 +54,9 @@
 #include <vector>
 
 #include "compiler/pipeline.hpp"
-#include "compiler/print.hpp"
-#include "runtime/evaluate.hpp"
-#include "runtime/fit.hpp"
+#include "ir/print.hpp"
+#include "runtime/operators/evaluate.hpp"
+#include "runtime/solve/fit.hpp"
 
 namespace sidc {
 namespace {

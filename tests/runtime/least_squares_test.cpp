@@ -14,8 +14,8 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "runtime/least_squares.hpp"
-#include "runtime/triangular_accumulator.hpp"
+#include "runtime/solve/least_squares.hpp"
+#include "runtime/solve/triangular_accumulator.hpp"
 
 namespace sidc {
 namespace {

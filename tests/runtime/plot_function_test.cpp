@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "compiler/pipeline.hpp"
-#include "runtime/plot_function.hpp"
+#include "runtime/operators/plot_function.hpp"
 
 namespace sidc {
 namespace {

@@ -10,8 +10,8 @@
 #include <random>
 #include <string>
 
-#include "runtime/records.hpp"
-#include "runtime/sampling.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/records/sampling.hpp"
 
 namespace sidc {
 namespace {

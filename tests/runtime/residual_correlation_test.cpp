@@ -3,7 +3,7 @@
 // correlated across their join, and short, constant or non-finite input comes back as a status.
 //
 // Relies on: std::mt19937 with fixed seeds (deterministic with one standard library).
-#include "runtime/residual_correlation.hpp"
+#include "runtime/solve/residual_correlation.hpp"
 
 #include <algorithm>
 #include <cmath>

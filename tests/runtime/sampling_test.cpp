@@ -5,9 +5,9 @@
 #include <cmath>
 #include <random>
 
-#include "runtime/records.hpp"
-#include "runtime/sampling.hpp"
-#include "runtime/savitzky_golay.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/records/sampling.hpp"
+#include "runtime/operators/savitzky_golay.hpp"
 
 namespace sidc {
 namespace {

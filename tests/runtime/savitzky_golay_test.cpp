@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "runtime/savitzky_golay.hpp"
+#include "runtime/operators/savitzky_golay.hpp"
 
 namespace sidc {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "runtime/simpson.hpp"
+#include "runtime/operators/simpson.hpp"
 
 namespace sidc {
 namespace {

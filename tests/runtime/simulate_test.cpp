@@ -5,11 +5,11 @@
 #include <iostream>
 #include <gtest/gtest.h>
 
-#include "compiler/explicit_form.hpp"
+#include "compiler/explicit_form_pass.hpp"
 #include "compiler/pipeline.hpp"
-#include "runtime/point_evaluator.hpp"
-#include "runtime/simulate.hpp"
-#include "runtime/validate.hpp"
+#include "runtime/operators/point_evaluator.hpp"
+#include "runtime/simulate/simulate.hpp"
+#include "runtime/simulate/validate.hpp"
 
 namespace sidc {
 namespace {

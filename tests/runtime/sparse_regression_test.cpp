@@ -9,10 +9,10 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "runtime/best_subset.hpp"
-#include "runtime/forward_regression.hpp"
-#include "runtime/sequential_threshold.hpp"
-#include "runtime/triangular_accumulator.hpp"
+#include "runtime/select/best_subset.hpp"
+#include "runtime/select/forward_regression.hpp"
+#include "runtime/select/sequential_threshold.hpp"
+#include "runtime/solve/triangular_accumulator.hpp"
 
 namespace sidc {
 namespace {

@@ -1,4 +1,4 @@
-// The streamed fit (FitOptions::stream_above_entries, runtime/block_evaluator.hpp,
+// The streamed fit (FitOptions::stream_above_entries, runtime/operators/block_evaluator.hpp,
 // TriangularAccumulator::rows_area) against the dense one on problems where both run: the thesis'
 // section 4-1 models (guards, an input defined in the model, the integrated form with its
 // integration constants), several records, every other sample, row weights, and the section 4-2
@@ -11,9 +11,9 @@
 #include <sstream>
 
 #include "compiler/pipeline.hpp"
-#include "runtime/bind_record.hpp"
-#include "runtime/block_evaluator.hpp"
-#include "runtime/fit.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/operators/block_evaluator.hpp"
+#include "runtime/solve/fit.hpp"
 
 #include "support/shell.hpp"
 

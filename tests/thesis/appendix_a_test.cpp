@@ -24,10 +24,10 @@
 #include <iostream>
 #include <set>
 
-#include "compiler/explicit_form.hpp"
+#include "compiler/explicit_form_pass.hpp"
 #include "compiler/pipeline.hpp"
-#include "runtime/records.hpp"
-#include "runtime/simulate.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/simulate/simulate.hpp"
 
 #include "support/shell.hpp"
 

@@ -9,7 +9,7 @@
 
 #include "compiler/pipeline.hpp"
 #include "process_record.hpp"
-#include "runtime/fit.hpp"
+#include "runtime/solve/fit.hpp"
 
 #include "support/shell.hpp"
 

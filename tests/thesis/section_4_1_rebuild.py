@@ -7,7 +7,7 @@ Relies on: Python 3.8+ standard library only (decimal, math, csv, json), and
 examples/thesis-4-1/appendix_a.csv. Guarantees: the design matrices of Table 4-1.2 (eq. 4-1.8)
 and of eq. 4-1.11 are rebuilt from the model definitions and the Appendix A record with the
 thesis' operators (eq. 3-1.7, applied twice for y'', eq. 3-1.8; Simpson integration as sidc's
-runtime/simpson.hpp documents it), and solved in decimal arithmetic of any precision: 50 digits
+runtime/operators/simpson.hpp documents it), and solved in decimal arithmetic of any precision: 50 digits
 (the reference, which must match sidc's double-precision QR) or 8 digits (the IBM 1620's word,
 the thesis' own explanation of its rows 4-6).
 
@@ -140,7 +140,7 @@ def derivative_form(every, powers, ctx, to="0.82"):
 
 
 def cumulative(values, h, rule):
-    """Cumulative integral from sample 0 (runtime/simpson.hpp, the same formulas)."""
+    """Cumulative integral from sample 0 (runtime/operators/simpson.hpp, the same formulas)."""
     f = [float(v) for v in values]
     out = [0.0] * len(f)
     for i in range(1, len(f)):

@@ -1,0 +1,293 @@
+#include "diagnostics/data_catalogue.hpp"
+
+#include <cctype>
+#include <fmt/format.h>
+
+#include "diagnostics/model_catalogue.hpp"
+
+namespace sidc::data_diag {
+namespace {
+
+Diagnostic located(std::string code, std::string_view path, int row, int column, std::string message,
+                   std::string hint = {}) {
+  Diagnostic d;
+  d.code = std::move(code);
+  d.data_file = std::string(path);
+  d.row = row;
+  d.column = column;
+  d.message = std::move(message);
+  d.hint = std::move(hint);
+  return d;
+}
+
+// Text as it may be shown on a terminal: printable ASCII only, and at most `limit` characters,
+// so that binary bytes or a 10 MB field cannot garble the message. Cells and names are cut at
+// 24 characters; paths are not cut.
+std::string shown(std::string_view text, std::size_t limit = 24) {
+  std::string out;
+  for (char c : text.substr(0, limit)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u >= 0x20 && u < 0x7f) ? c : '?';
+  }
+  if (text.size() > limit) out += "...";
+  return out;
+}
+
+std::string shown_path(std::string_view path) { return shown(path, std::string_view::npos); }
+
+const char* separator_hint(bool blank_separated) {
+  return blank_separated
+             ? "in a blank-separated file a run of spaces and tabs is one separator, so an empty cell cannot be "
+               "written and a name must not contain a space; use commas, or fill the cell"
+             : "every row needs one cell per header name; check for a stray or missing separator";
+}
+
+}  // namespace
+
+Diagnostic cannot_open(std::string_view path, std::string_view reason) {
+  Diagnostic d;
+  d.code = "data-cannot-open";
+  d.message = fmt::format("cannot read data file `{}`: {}", shown_path(path), reason);
+  d.hint = "check the path: a path in a model's `data` statement is relative to the model file, one given with `--data` to the current directory";
+  return d;
+}
+
+Diagnostic is_directory(std::string_view path) {
+  Diagnostic d;
+  d.code = "data-is-directory";
+  d.message = fmt::format("data file `{}` is a directory", shown_path(path));
+  d.hint = "name a CSV file inside it";
+  return d;
+}
+
+Diagnostic empty_file(std::string_view path) {
+  return located("data-empty-file", path, 1, 1, "data file holds no data (it is empty, or only comments and blank lines)",
+                 "a record needs a header line of column names and one row per sample");
+}
+
+Diagnostic binary_file(std::string_view path, int row, int column) {
+  return located("data-binary-file", path, row, column, "data file is not text (it contains a NUL byte)",
+                 "sidc reads CSV text; export the record as CSV (UTF-16 text must be saved as UTF-8 or ASCII)");
+}
+
+Diagnostic no_data_rows(std::string_view path, int header_row) {
+  return located("data-no-rows", path, header_row, 1, "data file has a header but no data rows",
+                 "add one row of numbers per sample below the header");
+}
+
+Diagnostic invalid_csv_options(std::string_view why) {
+  Diagnostic d;
+  d.code = "data-invalid-options";
+  d.message = fmt::format("invalid CSV options: {}", why);
+  return d;
+}
+
+Diagnostic unterminated_quote(std::string_view path, int row, int column) {
+  return located("data-unterminated-quote", path, row, column, "unterminated quote in the header",
+                 "close the quoted name with `\"` before the end of the line");
+}
+
+Diagnostic duplicate_column(std::string_view path, int row, int column, std::string_view name, int first_column) {
+  return located("data-duplicate-column", path, row, column,
+                 fmt::format("duplicate column name `{}` (first used in column {})", shown(name), first_column),
+                 "give every column a different name");
+}
+
+Diagnostic too_many_fields(std::string_view path, int row, int column, std::size_t expected, bool blank_separated) {
+  return located("data-too-many-fields", path, row, column,
+                 fmt::format("row has more fields than the {} column{} of the header", expected,
+                             expected == 1 ? "" : "s"),
+                 separator_hint(blank_separated));
+}
+
+Diagnostic too_few_fields(std::string_view path, int row, int column, std::size_t found, std::size_t expected,
+                          bool blank_separated) {
+  return located("data-too-few-fields", path, row, column,
+                 fmt::format("row has {} field{} but the header has {} column{}", found, found == 1 ? "" : "s",
+                             expected, expected == 1 ? "" : "s"),
+                 separator_hint(blank_separated));
+}
+
+Diagnostic bad_cell(std::string_view path, int row, int column, std::string_view column_name, CellFault fault,
+                    std::string_view text) {
+  const std::string name = shown(column_name);
+  const std::string quoted = text.empty() ? std::string() : fmt::format(" `{}`", shown(text));
+  switch (fault) {
+    case CellFault::empty:
+      return located("data-empty-cell", path, row, column, fmt::format("empty cell in column `{}`", name),
+                     "every sample of a column the model uses must hold a number; fill the cell or choose a time "
+                     "window that leaves this row out");
+    case CellFault::not_a_number:
+      return located("data-nan-cell", path, row, column, fmt::format("cell{} in column `{}` is NaN", quoted, name),
+                     "sidc needs a finite number in every used sample; fill the gap or choose a time window that "
+                     "leaves this row out");
+    case CellFault::infinite:
+      return located("data-infinite-cell", path, row, column,
+                     fmt::format("cell{} in column `{}` is infinite", quoted, name),
+                     "sidc needs a finite number in every used sample; fix the cell or choose a time window that "
+                     "leaves this row out");
+    case CellFault::decimal_comma:
+      return located("data-decimal-comma", path, row, column,
+                     fmt::format("cell{} in column `{}` uses a decimal comma", quoted, name),
+                     "write decimal points (1.5, not 1,5), or read the file with the decimal-comma option");
+    case CellFault::out_of_range:
+      return located("data-out-of-range-cell", path, row, column,
+                     fmt::format("cell{} in column `{}` is beyond the range of a double", quoted, name),
+                     "rescale the column; doubles reach about 1.8e308");
+    case CellFault::non_numeric:
+    case CellFault::none:
+      break;
+  }
+  return located("data-non-numeric-cell", path, row, column,
+                 fmt::format("cell{} in column `{}` is not a number", quoted, name),
+                 "numbers look like 12, -0.5, .25, 760. or 1.5E+03; remove units and thousands separators");
+}
+
+Diagnostic unknown_column(std::string_view path, int header_row, std::string_view name,
+                          const std::vector<std::string>& names) {
+  // Any one-letter name is one edit away from any other, so for those only a difference of case
+  // is a plausible slip (`X` for `x`); longer names take the catalogue's edit-distance rule.
+  std::string near;
+  if (name.size() == 1) {
+    for (const auto& candidate : names)
+      if (candidate.size() == 1 && std::tolower(static_cast<unsigned char>(candidate[0])) ==
+                                       std::tolower(static_cast<unsigned char>(name[0])))
+        near = candidate;
+  } else {
+    near = diag::nearest(name, names);
+  }
+  std::string list;
+  for (std::size_t i = 0; i < names.size() && i < 12; ++i) list += (i ? ", " : "") + shown(names[i]);
+  if (names.size() > 12) list += ", ...";
+  return located("data-unknown-column", path, header_row > 0 ? header_row : 1, 1,
+                 fmt::format("no column named `{}` (columns: {})", shown(name), list),
+                 near.empty() ? std::string("name the column in the header line, or map the signal to a column")
+                              : fmt::format("did you mean `{}`?", near));
+}
+
+Diagnostic too_few_samples(std::string_view path, int row, int column, std::string_view name, std::size_t count) {
+  return located("data-too-few-samples", path, row, column,
+                 fmt::format("time column `{}` has {} sample{}; a step needs at least 2", shown(name), count,
+                             count == 1 ? "" : "s"));
+}
+
+Diagnostic time_repeats(std::string_view path, int row, int column, std::string_view name, double value) {
+  return located("data-time-repeats", path, row, column,
+                 fmt::format("time `{}` repeats the previous row's value {}", shown(name), value),
+                 "remove the duplicated row");
+}
+
+Diagnostic time_goes_backwards(std::string_view path, int row, int column, std::string_view name, double previous,
+                               double value) {
+  return located("data-time-backwards", path, row, column,
+                 fmt::format("time `{}` goes backwards, from {} to {}", shown(name), previous, value),
+                 "rows must be in time order; sort the file or remove the misplaced row");
+}
+
+Diagnostic time_step_not_uniform(std::string_view path, int row, int column, std::string_view name, double found,
+                                 double expected, double relative_tolerance) {
+  return located("data-time-step-not-uniform", path, row, column,
+                 fmt::format("time step of `{}` is {} here but {} elsewhere (tolerance {} relative)", shown(name),
+                             found, expected, relative_tolerance),
+                 "derivatives and integrals need uniform sampling; use --resample to interpolate onto a uniform "
+                 "grid, or fix the missing or extra samples");
+}
+
+Diagnostic invalid_resampling_step(double step) {
+  Diagnostic d;
+  d.code = "data-invalid-resampling-step";
+  d.message = fmt::format("resampling step {} is not a positive number", step);
+  d.hint = "give the step in the time column's units, such as --resample 0.01";
+  return d;
+}
+
+Diagnostic empty_time_window(std::string_view path, std::string_view name, double from, double to, double first,
+                             double last) {
+  return located("data-empty-window", path, 1, 1,
+                 fmt::format("no sample of `{}` lies in the window [{}, {}]; the record spans [{}, {}]", shown(name),
+                             from, to, first, last),
+                 "choose a window inside the record");
+}
+
+Diagnostic no_time_column(std::string_view path, int header_row) {
+  return located("data-no-time-column", path, header_row, 1,
+                 "the record has no time column (`t` or `time`) and no sampling step was given",
+                 fmt::format("bind one in the model (`data \"{}\" (t = \"seconds\")`), or give the step with `set step = 0.01` "
+                             "or `--step 0.01`", path));
+}
+
+Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int order, std::size_t margin, bool cut_by_window) {
+  Diagnostic d;
+  d.code = "data-empty-fit-window";
+  d.message = fmt::format("no samples of `{}` are left in the fit window", path);
+  d.hint = fmt::format("the record has {} samples; derivatives of order {} lose {} at each edge{}", samples, order, margin,
+                       cut_by_window ? ", and `from`/`to` cut it further" : "");
+  return d;
+}
+
+Diagnostic invalid_signal_options(std::string_view operation, std::string_view why) {
+  Diagnostic d;
+  d.code = "signal-invalid-options";
+  d.message = fmt::format("invalid options for {}: {}", operation, why);
+  return d;
+}
+
+Diagnostic signal_shorter_than_window(std::size_t samples, int window) {
+  Diagnostic d;
+  d.code = "signal-too-short";
+  d.message = fmt::format("the signal has {} sample{} but the moving arc needs {}", samples, samples == 1 ? "" : "s",
+                          window);
+  d.hint = "use a longer record or a smaller window";
+  return d;
+}
+
+}  // namespace sidc::data_diag
+
+// ---- evaluation on data, pointing at the model term that asked for it --------------------------
+namespace sidc::diag {
+
+Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record) {
+  return error("operation-not-finite", where,
+               fmt::format("`{}`{} is not a finite number at t = {} in `{}`", operation, owner.empty() ? "" : fmt::format(" ({})", owner), time, record),
+               "check the record there (a zero under a division or a log, a huge power), or narrow the fit window with `set from`/`set to`");
+}
+
+Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record) {
+  return error("initial-value-unavailable", where, fmt::format("`{}` has no value at t = {} in `{}`", value, time, record),
+               "a derivative has no estimate near the edges of the record under `edges = drop`; use a later time or `set edges = shorten`");
+}
+
+Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last) {
+  return error("initial-value-outside-record", where, fmt::format("`{}` asks for t = {}, outside the record ({} to {})", value, time, first, last),
+               "give a time within the record");
+}
+
+Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record) {
+  return error("signal-not-in-record", where, fmt::format("signal `{}` has no values in `{}`", signal, record),
+               fmt::format("bind it to a column in the data statement, e.g. `data \"{}\" ({} = \"column\")`", record, signal));
+}
+
+Diagnostic no_data_file(const Span& where) {
+  return error("no-data-file", where, "the model names no record to fit",
+               "add `data \"record.csv\"` to the model, or give one with `sidc fit --data record.csv`");
+}
+
+Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin) {
+  return error("window-too-short", {},
+               fmt::format("`{}` leaves {} rows in the fit window for {} parameters", record, rows, parameters),
+               fmt::format("the moving-arc derivatives lose {} samples at each edge; use a longer record, a wider window "
+                           "(`set from`/`set to`), fewer parameters, or `set edges = shorten`", margin));
+}
+
+Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record) {
+  return error("weight-not-valid", where,
+               fmt::format("the weights `{}` are {} at t = {} in `{}`; a weight must be a finite number >= 0 (eq. 2-1.6)", weights,
+                           value, time, record),
+               "write the weights so that they cannot go negative (e.g. a square or an abs()), or narrow the fit window with "
+               "`set from`/`set to`");
+}
+// [end of compiler-owned section]
+
+// ---- simulation (compiler/explicit_form_pass.cpp, runtime/simulate/simulate.cpp)
+
+}  // namespace sidc::diag

@@ -1,0 +1,88 @@
+// Every message sidc prints about a data file (a record), one named constructor each, the data
+// counterpart of diagnostics/model_catalogue.hpp. records.cpp and sampling.cpp build
+// Diagnostics only through these, so the wording lives in one place and the bad-record tests
+// (tests/runtime/bad_records_test.cpp, files in tests/data/bad/) pin every one of them.
+//
+// Locations are `file:row:col` with row = 1-based line number in the file (comments, blank lines
+// and the header count) and col = 1-based field index on that line. Codes are stable: tests rely
+// on them. A problem with no sensible location (the file cannot be opened)
+// carries no data_file and names the path in its message instead.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "diagnostics/diagnostic.hpp"
+
+namespace sidc::data_diag {
+
+// What is wrong with one cell of a numeric column.
+enum class CellFault : unsigned char {
+  none,
+  empty,          // nothing between the separators
+  not_a_number,   // the text `nan` (any case)
+  infinite,       // `inf`, `-Infinity`, ...
+  non_numeric,    // text that is not a number at all
+  decimal_comma,  // `1,5` in a semicolon or blank separated file
+  out_of_range,   // beyond the range of a double (1e400)
+};
+
+// ---- the file as a whole (records.cpp) ---------------------------------------------------------
+Diagnostic cannot_open(std::string_view path, std::string_view reason);
+Diagnostic is_directory(std::string_view path);
+Diagnostic empty_file(std::string_view path);
+Diagnostic binary_file(std::string_view path, int row, int column);
+Diagnostic no_data_rows(std::string_view path, int header_row);
+Diagnostic invalid_csv_options(std::string_view why);
+
+// ---- the header (records.cpp) ------------------------------------------------------------------
+Diagnostic unterminated_quote(std::string_view path, int row, int column);
+Diagnostic duplicate_column(std::string_view path, int row, int column, std::string_view name, int first_column);
+
+// ---- row shape (records.cpp) -------------------------------------------------------------------
+Diagnostic too_many_fields(std::string_view path, int row, int column, std::size_t expected, bool blank_separated);
+Diagnostic too_few_fields(std::string_view path, int row, int column, std::size_t found, std::size_t expected,
+                          bool blank_separated);
+
+// ---- a used column (records.cpp) ---------------------------------------------------------------
+// `text` is the cell as written (may be empty when it is not known); it is shown sanitised.
+Diagnostic bad_cell(std::string_view path, int row, int column, std::string_view column_name, CellFault fault,
+                    std::string_view text);
+Diagnostic unknown_column(std::string_view path, int header_row, std::string_view name,
+                          const std::vector<std::string>& names);
+
+// ---- the time column (sampling.cpp) ------------------------------------------------------------
+Diagnostic too_few_samples(std::string_view path, int row, int column, std::string_view name, std::size_t count);
+Diagnostic time_repeats(std::string_view path, int row, int column, std::string_view name, double value);
+Diagnostic time_goes_backwards(std::string_view path, int row, int column, std::string_view name, double previous,
+                               double value);
+Diagnostic time_step_not_uniform(std::string_view path, int row, int column, std::string_view name, double found,
+                                 double expected, double relative_tolerance);
+Diagnostic invalid_resampling_step(double step);
+Diagnostic empty_time_window(std::string_view path, std::string_view name, double from, double to, double first,
+                             double last);
+
+// ---- signal operations (savitzky_golay.cpp, simpson.cpp); no location: the caller adds the
+// span of the model term that asked for the operation ---------------------------------------------
+Diagnostic invalid_signal_options(std::string_view operation, std::string_view why);
+// Binding a record to a model (runtime/records/bind_record.cpp, runtime/operators/evaluate.cpp).
+Diagnostic no_time_column(std::string_view path, int header_row);
+Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int order, std::size_t margin, bool cut_by_window);
+Diagnostic signal_shorter_than_window(std::size_t samples, int window);
+
+}  // namespace sidc::data_diag
+
+namespace sidc::diag {
+
+// ---- evaluation on data (runtime/), pointing at the model term that asked for it
+Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record);
+Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);
+Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last);
+Diagnostic no_data_file(const Span& where);
+Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record);
+Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin);
+// `set weights = <expression>` (eq. 2-1.6) is negative, NaN or infinite on a row of the fit window.
+Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record);
+
+}  // namespace sidc::diag

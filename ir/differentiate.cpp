@@ -1,0 +1,123 @@
+#include "ir/differentiate.hpp"
+
+namespace sidc {
+namespace {
+
+using ir::Factor;
+using ir::FactorKind;
+using ir::Sum;
+
+Sum function_of(const std::string& name, const Sum& argument) {
+  return ir::factor(Factor{FactorKind::function, name, 0, {}, {}, ir::share(argument), {}});
+}
+
+// d/dt of a single factor (power 1), or nullopt.
+std::optional<Sum> derivative_of(const Factor& f) {
+  switch (f.kind) {
+    case FactorKind::parameter:
+    case FactorKind::window_start:
+    case FactorKind::initial_value: return Sum{};
+    case FactorKind::signal: {
+      Factor next = f;
+      ++next.order;
+      return ir::factor(next);
+    }
+    case FactorKind::time:
+    case FactorKind::elapsed: return ir::number(1);
+    case FactorKind::integral: return *f.argument;  // d/dt int(u) = u
+    case FactorKind::derivative: {
+      Factor next = f;
+      ++next.order;
+      return ir::factor(next);
+    }
+    case FactorKind::guard: return std::nullopt;
+    case FactorKind::power: {  // (u^e)' = e u^(e-1) u'
+      auto du = differentiate(*f.argument);
+      if (!du) return std::nullopt;
+      auto lowered = raise(*f.argument, f.exponent - Number(1));
+      if (!lowered) return std::nullopt;
+      return ir::scale(ir::multiply(*lowered, *du), f.exponent);
+    }
+    case FactorKind::function: {
+      const Sum& u = *f.argument;
+      auto du = differentiate(u);
+      if (!du) return std::nullopt;
+      Sum outer;
+      if (f.name == "sin") outer = function_of("cos", u);
+      else if (f.name == "cos") outer = ir::negate(function_of("sin", u));
+      else if (f.name == "exp") outer = function_of("exp", u);
+      else if (f.name == "log") outer = reciprocal(u);
+      else if (f.name == "sqrt") outer = ir::scale(reciprocal(function_of("sqrt", u)), Number::rational(1, 2));
+      else if (f.name == "tanh") {
+        const Sum th = function_of("tanh", u);
+        outer = ir::subtract(ir::number(1), ir::multiply(th, th));
+      } else if (f.name == "abs") outer = function_of("sign", u);
+      else return std::nullopt;  // sign() jumps
+      return ir::multiply(outer, *du);
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Sum reciprocal(const Sum& u) {
+  if (u.terms.size() == 1 && u.terms[0].coefficient.exact()) {
+    ir::Term t = u.terms[0];
+    t.coefficient = Number(1) / t.coefficient;
+    for (auto& f : t.factors) f.second = -f.second;
+    return ir::canonical(std::vector<ir::Term>{ir::canonical(t)});
+  }
+  return ir::factor(Factor{FactorKind::power, "", 0, {}, Number(-1), ir::share(u), {}});
+}
+
+std::optional<Sum> raise(const Sum& u, const Number& e, std::size_t max_terms) {
+  if (e.is_zero()) return ir::number(1);
+  if (e.is_integer() && e.numerator() > 0) {
+    Sum result = ir::number(1);
+    for (std::int64_t k = 0; k < e.numerator(); ++k) {
+      if (result.terms.size() * u.terms.size() > max_terms) return std::nullopt;
+      result = ir::multiply(result, u);
+    }
+    return result;
+  }
+  if (e.is_integer() && u.terms.size() == 1) {  // a single term to a negative power
+    Sum inverse = reciprocal(u);
+    return raise(inverse, -e, max_terms);
+  }
+  if (u.empty()) return Sum{};
+  // A single atomic factor to a fractional power stays one factor: y^1.5.
+  return ir::factor(Factor{FactorKind::power, "", 0, {}, e, ir::share(u), {}});
+}
+
+std::optional<Sum> differentiate(const ir::Term& t) {
+  std::vector<ir::Term> terms;
+  for (std::size_t i = 0; i < t.factors.size(); ++i) {
+    const auto& [f, power] = t.factors[i];
+    auto df = derivative_of(f);
+    if (!df) return std::nullopt;
+    // d(f^k) = k f^(k-1) f', times the other factors.
+    ir::Term rest{t.coefficient * Number(power), {}, t.span};
+    for (std::size_t j = 0; j < t.factors.size(); ++j)
+      rest.factors.push_back(j == i ? std::pair{f, power - 1} : t.factors[j]);
+    rest = ir::canonical(rest);
+    for (const auto& dt : df->terms) terms.push_back(ir::multiply(rest, dt));
+  }
+  return ir::canonical(std::move(terms));
+}
+
+std::optional<Sum> differentiate(const Sum& s, int times) {
+  Sum current = s;
+  for (int k = 0; k < times; ++k) {
+    std::vector<ir::Term> terms;
+    for (const auto& t : current.terms) {
+      auto dt = differentiate(t);
+      if (!dt) return std::nullopt;
+      terms.insert(terms.end(), dt->terms.begin(), dt->terms.end());
+    }
+    current = ir::canonical(std::move(terms));
+  }
+  return current;
+}
+
+}  // namespace sidc

@@ -1,0 +1,37 @@
+#include "ir/queries.hpp"
+
+#include <algorithm>
+
+#include "ir/traversal.hpp"
+
+namespace sidc {
+
+int derivative_burden(const ir::Equation& e) {
+  int b = ir::highest_derivative_order(e.known);
+  for (const auto& p : e.terms) b = std::max(b, ir::highest_derivative_order(p.operation));
+  return b;
+}
+
+bool is_dynamic(const ir::Sum& s) {
+  return ir::any_factor(s, [](const ir::Factor& f) {
+    switch (f.kind) {
+      case ir::FactorKind::signal: return f.order > 0;
+      case ir::FactorKind::time:
+      case ir::FactorKind::elapsed:
+      case ir::FactorKind::derivative:
+      case ir::FactorKind::integral: return true;
+      default: return false;  // constants; functions, powers and guards are decided by what they hold
+    }
+  });
+}
+
+bool is_static(const ir::Model& model) {
+  for (const auto& e : model.equations) {
+    if (is_dynamic(e.known)) return false;
+    for (const auto& p : e.terms)
+      if (is_dynamic(p.operation)) return false;
+  }
+  return true;
+}
+
+}  // namespace sidc

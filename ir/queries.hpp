@@ -1,0 +1,21 @@
+// Questions asked of a compiled model by more than one layer: what estimating its derivatives
+// costs, and whether it is dynamic at all. The compiler's integrate_pass chooses the number of
+// integrations with them; the runtime sizes derivative margins and decides whether a record needs
+// a time column. They live here, beside the IR, so that neither reaches into the other.
+#pragma once
+
+#include "ir/ir.hpp"
+
+namespace sidc {
+
+// The highest derivative order anywhere in the equation, inside integrals and functions too.
+int derivative_burden(const ir::Equation& e);
+
+// True when the sum changes with time: a derivative, t, tau, der() or int() anywhere in it.
+bool is_dynamic(const ir::Sum& s);
+
+// True when no equation has a derivative, an integral or the time in it: a static regression such
+// as NIST's `y = b0 + b1*x`, whose records need no time column.
+bool is_static(const ir::Model& model);
+
+}  // namespace sidc

@@ -1,0 +1,47 @@
+// The settings a model file can carry (`set key = value`), their allowed values, and their typed
+// form. The compiler checks and types them here so that the runtime never reads setting text.
+// docs/language.md ("Settings") lists them; command-line options of `sidc fit` override them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ir/ir.hpp"
+
+namespace sidc {
+
+inline constexpr int kMaxFamilySize = 10000;  // members of one `param c[a..b]` or one `sum`
+inline constexpr int kMaxIntegrations = 8;
+
+struct SettingCheck {
+  bool unknown_key = false;
+  std::string expected;  // non-empty when the value is invalid: what the key takes
+};
+SettingCheck check_setting(const std::string& key, const std::string& value);
+const std::vector<std::string>& setting_keys();
+
+// A moving-arc (Savitzky-Golay) operator: polynomial of `order` fitted to `window` points.
+struct MovingArc {
+  int window = 7;  // the thesis' 7-point cubic, eqs. 3-1.6 to 3-1.8
+  int order = 3;
+};
+
+struct EvaluationSettings {
+  MovingArc derivative;
+  bool second_derivative_repeated = true;  // eq. 3-1.8: the first-derivative operator applied twice
+  bool shorten_edges = false;              // thesis: drop points without a full neighbourhood
+  bool trapezoid = false;                  // integration rule; Simpson by default (section 3-2)
+  std::optional<MovingArc> smooth_before_integration;
+  std::optional<double> from, to;          // fit window in time
+  int every = 1;                           // decimation
+  std::optional<double> step;              // sampling step when the record has no time column
+  std::optional<std::string> weights;      // a record column weighting each row's residual (eq. 2-1.6)
+};
+
+// Typed settings from checked raw values (check_setting has accepted every one).
+EvaluationSettings evaluation_settings(const ir::Settings& settings);
+// Reads `savgol(7, 3)`; nullopt if the text is not of that form with a valid window and order.
+std::optional<MovingArc> parse_moving_arc(const std::string& text);
+
+}  // namespace sidc

@@ -1,0 +1,374 @@
+#include "report/fit_pictures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <limits>
+#include <map>
+#include <memory>
+
+#include "ir/print.hpp"
+#include "report/fit_figures.hpp"
+#include "report/gnuplot_renderer.hpp"
+#include "report/html_report.hpp"
+#include "runtime/operators/plot_function.hpp"
+#include "runtime/records/records.hpp"
+
+namespace sidc {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> input_names(const ir::Model& model) {
+  std::vector<std::string> names;
+  for (const auto& s : model.signals)
+    if (s.kind == ir::Signal::Kind::input) names.push_back(s.name);
+  return names;
+}
+
+// Fitted values by the model's parameter order (integration constants are no model parameters).
+std::vector<double> parameter_values(const ir::Model& model, const FitSummary& summary) {
+  std::vector<double> values(model.parameters.size(), std::numeric_limits<double>::quiet_NaN());
+  for (const auto& g : summary.groups)
+    for (const auto& p : g.summary.parameters)
+      if (const int i = model.parameter_index(p.name); i >= 0) values[static_cast<std::size_t>(i)] = p.value;
+  return values;
+}
+
+// The values of one signal derivative over the fit window of a record, as the fit estimated them.
+struct WindowValues {
+  std::vector<double> time, values;
+};
+
+// One record's estimates, through one Evaluator: it keeps each derivative it has estimated, so a
+// derivative drawn in several figures (a plot's range, the phase plane, the derivative errors) is
+// estimated once.
+class WindowEstimates {
+ public:
+  WindowEstimates(const SampledRecord& record, const ir::Model& model, const FitOptions& options) : record_(record) {
+    auto window = fit_window(record, model, options.evaluation, options.from, options.to);
+    if (auto* w = std::get_if<FitWindow>(&window)) evaluator_ = std::make_unique<Evaluator>(record, model, options.evaluation, *w);
+  }
+
+  std::optional<WindowValues> of(const std::string& signal, int order) {
+    if (!evaluator_) return std::nullopt;
+    ir::Factor f{ir::FactorKind::signal, signal, order, {}, {}, {}, {}};
+    auto all = evaluator_->evaluate(ir::factor(f));
+    if (!std::holds_alternative<std::vector<double>>(all)) return std::nullopt;
+    const auto& v = std::get<std::vector<double>>(all);
+    const FitWindow& w = evaluator_->window();
+    WindowValues out;
+    for (std::size_t k = w.first; k <= w.last && k < v.size(); ++k) {
+      out.time.push_back(record_.time[k]);
+      out.values.push_back(v[k]);
+    }
+    return out;
+  }
+
+ private:
+  const SampledRecord& record_;
+  std::unique_ptr<Evaluator> evaluator_;  // null when the record has no fit window
+};
+
+// An exact derivative recorded in the file beside the output (`y' = "ydot"`), at the times of `at`.
+std::optional<std::vector<double>> exact_column(const Record& r, const ir::DataSource& source, const std::string& column,
+                                                const std::vector<double>& at) {
+  std::string time_name = "t";
+  for (const auto& [signal, col] : source.bindings)
+    if (signal == "t") time_name = col;
+  const std::vector<double>* time = r.column(time_name);
+  if (!time && time_name == "t") time = r.column("time");
+  const std::vector<double>* values = r.column(column);
+  if (!time || !values || time->size() < 2) return std::nullopt;
+  const double t0 = time->front(), step = ((*time)[time->size() - 1] - t0) / static_cast<double>(time->size() - 1);
+  if (!(step > 0) || !std::isfinite(step)) return std::nullopt;  // no uniform time column to match by
+  std::vector<double> out;
+  for (double t : at) {
+    const double k = std::round((t - t0) / step);
+    const bool inside = std::isfinite(k) && k >= 0 && k < static_cast<double>(values->size());
+    const auto i = inside ? static_cast<std::size_t>(k) : 0;
+    out.push_back(inside && std::abs((*time)[i] - t) <= 1e-6 * std::max(1.0, std::abs(t)) + 1e-3 * step
+                      ? (*values)[i]
+                      : std::numeric_limits<double>::quiet_NaN());
+  }
+  return out;
+}
+
+// The highest derivative of `signal` written in the sum (guards, functions and integrals included).
+int order_of(const ir::Sum& s, const std::string& signal) {
+  int order = -1;
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) {
+      if (f.kind == ir::FactorKind::signal && f.name == signal) order = std::max(order, f.order);
+      if (f.argument) order = std::max(order, order_of(*f.argument, signal));
+      for (const auto& c : f.conditions) order = std::max({order, order_of(*c.lhs, signal), order_of(*c.rhs, signal)});
+    }
+  return order;
+}
+
+int order_of(const ir::Model& normalized, const std::string& signal) {
+  int order = -1;
+  for (const auto& e : normalized.equations) {
+    order = std::max(order, order_of(e.known, signal));
+    for (const auto& term : e.terms) order = std::max(order, order_of(term.operation, signal));
+  }
+  return order;
+}
+
+struct NamedFigure {
+  Figure figure;
+  int group = -1;  // the equation group it belongs to in the report; -1: the whole fit
+};
+
+std::vector<NamedFigure> fit_figures(const PictureContext& c) {
+  std::vector<NamedFigure> figures;
+  const ir::Model& model = c.compiled.integrated;
+  const ir::Model& normalized = c.compiled.normalized;
+  const SignalLabel time{"t", ""};
+  const auto suffix = [&](std::size_t r) { return c.records.size() > 1 ? fmt::format("_r{}", r + 1) : std::string(); };
+
+  // Figs. 4-2.5/4-2.6 and 4-2.7: the solved fitted equations against each record.
+  for (std::size_t v = 0; v < c.validations.size(); ++v) {
+    const ValidationSummary& run = c.validations[v];
+    for (std::size_t o = 0; o < run.outputs.size(); ++o) {
+      const SignalLabel output{run.outputs[o].output, ""};
+      Figure a = recorded_vs_simulated_figure(time, output, run.simulation.time, run.recorded[o], run.simulated[o]);
+      Figure b = simulation_error_figure(time, output, run.simulation.time, run.recorded[o], run.simulated[o]);
+      const std::string s = c.validations.size() > 1 ? fmt::format("_r{}", v + 1) : std::string();
+      a.name += s, b.name += s;
+      figures.push_back({std::move(a)}), figures.push_back({std::move(b)});
+    }
+  }
+
+  std::vector<std::unique_ptr<WindowEstimates>> per_record;
+  for (const auto& record : c.records) per_record.push_back(std::make_unique<WindowEstimates>(record, model, c.options));
+
+  // Figs. 4-1.13/4-1.14: each plotted function over the range its argument covers in the records.
+  const std::vector<double> values = parameter_values(normalized, c.summary);
+  for (const auto& plot : normalized.plots) {
+    double low = INFINITY, high = -INFINITY;
+    for (auto& estimates : per_record)
+      if (auto w = estimates->of(plot.signal, plot.order))
+        for (double x : w->values)
+          if (std::isfinite(x)) low = std::min(low, x), high = std::max(high, x);
+    if (!(low < high)) continue;
+    auto curve = evaluate_plot_function(plot, values, low, high);
+    if (!std::holds_alternative<PlotCurve>(curve)) continue;
+    const PlotCurve& pc = std::get<PlotCurve>(curve);
+    const SignalLabel argument{pc.argument, ""}, value{pc.name, ""};
+    figures.push_back({reconstructed_function_figure(pc.name, argument, value, pc.x, pc.fitted,
+                                                     pc.truth.empty() ? std::nullopt : std::optional(pc.truth))});
+    if (!pc.truth.empty()) figures.push_back({reconstructed_function_error_figure(pc.name, argument, value, pc.x, pc.fitted, pc.truth)});
+  }
+
+  for (std::size_t r = 0; r < c.records.size(); ++r) {
+    const SampledRecord& record = c.records[r];
+    WindowEstimates& estimates = *per_record[r];
+    // Figs. 4-1.8/4-1.9: the moving-arc estimates against the exact derivatives the file records
+    // (the file is read again once: the fit kept only the columns it binds).
+    if (r < c.sources.size() && !c.sources[r].exact_derivatives.empty()) {
+      auto read = read_csv(c.sources[r].path);
+      std::map<std::string, std::vector<DerivativeComparison>> by_signal;
+      std::vector<double> at;
+      for (const auto& exact : c.sources[r].exact_derivatives) {
+        if (!std::holds_alternative<Record>(read)) break;
+        auto w = estimates.of(exact.signal, exact.order);
+        if (!w) continue;
+        auto truth = exact_column(std::get<Record>(read), c.sources[r], exact.column, w->time);
+        if (!truth) continue;
+        at = w->time;
+        by_signal[exact.signal].push_back({exact.order, w->values, *truth});
+      }
+      const auto& d = c.options.evaluation.derivative;
+      const std::string setting = fmt::format("Delta = {:g}, savgol({}, {})", record.step, d.window, d.polyorder);
+      for (const auto& [signal, comparisons] : by_signal) {
+        Figure f = derivative_error_figure(time, {signal, ""}, at, comparisons, setting);
+        f.name += suffix(r);
+        figures.push_back({std::move(f)});
+      }
+    }
+    // Fig. 4-1.7: the phase plane of each output of a second (or higher) order equation.
+    for (const auto& s : model.signals) {
+      if (s.kind != ir::Signal::Kind::output || order_of(normalized, s.name) < 2) continue;
+      auto y = estimates.of(s.name, 0);
+      auto y_dot = estimates.of(s.name, 1);
+      if (!y || !y_dot) continue;
+      Figure f = phase_plane_figure({s.name, ""}, "s", y->values, y_dot->values);
+      f.name += suffix(r);
+      figures.push_back({std::move(f)});
+    }
+  }
+
+  // Residual analysis (MATLAB's `resid`): one autocorrelation and one cross-correlation per input.
+  for (std::size_t g = 0; g < c.residuals.groups.size(); ++g) {
+    const auto& rc = c.residuals.groups[g];
+    if (!rc.is_usable()) continue;
+    const std::string group = std::to_string(g + 1);
+    figures.push_back({residual_autocorrelation_figure(rc, group), static_cast<int>(g)});
+    for (std::size_t i = 0; i < rc.cross.size(); ++i)
+      if (rc.cross[i].computed) figures.push_back({residual_cross_correlation_figure(rc, i, group), static_cast<int>(g)});
+  }
+  return figures;
+}
+
+ReportContent report_content(const PictureContext& c) {
+  const ir::Model& model = c.compiled.integrated;
+  ReportContent content;
+  content.title = fmt::format("sidc fit report: {}", model.name.empty() ? c.compiled_path : model.name);
+  content.model_name = model.name;
+  content.source_file = c.compiled.source->name;
+  content.model_text = c.compiled.source->text;
+  const auto& e = c.options.evaluation;
+  content.settings = {
+      {"derivatives", fmt::format("{}-point moving arc of order {} (section 3-1); second derivative {}", e.derivative.window,
+                                  e.derivative.polyorder,
+                                  e.derivative.second == DerivativeOptions::Second::repeated ? "by the first-derivative operator applied twice (eq. 3-1.8)"
+                                                                                             : "directly")},
+      {"edges", e.derivative.edges == DerivativeOptions::Edges::drop ? "samples without a full neighbourhood dropped (the thesis)"
+                                                                      : "shortened windows at the edges"},
+      {"fit window", fmt::format("{} to {}", c.options.from ? fmt::format("{:g}", *c.options.from) : std::string("the record's start"),
+                                 c.options.to ? fmt::format("{:g}", *c.options.to) : std::string("its end"))},
+  };
+  for (const auto& r : c.records) content.records.push_back(fmt::format("{} ({} samples, step {:g})", r.path, r.time.size(), r.step));
+  for (std::size_t g = 0; g < c.summary.groups.size(); ++g) {
+    const GroupFit& group = c.summary.groups[g];
+    ReportGroup out;
+    std::string numbers;
+    for (std::size_t i : group.equations) numbers += (numbers.empty() ? "" : ", ") + std::to_string(i + 1);
+    out.title = fmt::format("{} {}", group.equations.size() == 1 ? "Equation" : "Equations", numbers);
+    for (std::size_t i : group.equations) out.equations.push_back(print(model.equations[i], model));
+    fill_group_from(group.summary, c.options.least_squares.confidence_level, &out);
+    if (g < c.residuals.groups.size())
+      out.residual_verdicts.push_back(c.residuals.notes[g].empty() ? c.residuals.groups[g].verdict : c.residuals.notes[g]);
+    content.groups.push_back(std::move(out));
+  }
+  // The simulation covers every output at once: its table goes with the first group.
+  if (!content.groups.empty()) {
+    for (const auto& run : c.validations)
+      for (const auto& o : run.outputs)
+        content.groups.front().validation.push_back({o.output, run.record, o.max_abs_error, o.percent_error, o.fit_percent,
+                                                     run.simulation.completed() ? std::string() : run.statement});
+  }
+  if (!c.validation_note.empty()) content.notes.push_back("Validation by simulation " + c.validation_note);
+  content.generated_by = fmt::format("sidc {}", SIDC_VERSION);
+  return content;
+}
+
+}  // namespace
+
+ResidualAnalysis analyse_residuals(const ir::Model& model, const FitSummary& summary, const std::vector<SampledRecord>& records,
+                                   const FitOptions& options) {
+  ResidualAnalysis out;
+  const auto inputs = input_names(model);
+  for (std::size_t g = 0; g < summary.groups.size(); ++g) {
+    const GroupResiduals segments = group_residuals(model, records, options, summary, g, inputs, kMaxResidualRows);
+    out.truncated.push_back(segments.truncated);
+    if (!segments.ok) {
+      out.groups.emplace_back();
+      out.notes.push_back("not computed: " + segments.message);
+      continue;
+    }
+    out.groups.push_back(residual_correlation(segments.residuals, segments.inputs, {}));
+    out.notes.push_back(out.groups.back().is_usable() ? std::string() : "not computed: " + out.groups.back().message);
+  }
+  return out;
+}
+
+std::string residual_report(const ResidualAnalysis& analysis) {
+  std::string out;
+  for (std::size_t g = 0; g < analysis.groups.size(); ++g) {
+    const std::string group = analysis.groups.size() > 1 ? fmt::format(" (equation group {})", g + 1) : "";
+    if (!analysis.notes[g].empty()) {
+      out += fmt::format("\nresidual analysis{}: {}\n", group, analysis.notes[g]);
+      continue;
+    }
+    out += fmt::format("\n{}{}", group.empty() ? "" : fmt::format("equation group {}: ", g + 1), analysis.groups[g].brief_report());
+    if (g < analysis.truncated.size() && analysis.truncated[g])
+      out += fmt::format("{}  (the first {} rows only)\n", out.back() == '\n' ? "" : "\n", kMaxResidualRows);
+  }
+  if (!out.empty() && out.back() != '\n') out += "\n";
+  return out;
+}
+
+nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis) {
+  using nlohmann::ordered_json;
+  auto curve = [](const CorrelationCurve& c) {
+    return ordered_json{{"name", c.name}, {"computed", c.computed}, {"white", c.white}, {"verdict", c.verdict},
+                        {"lags", c.lags}, {"values", c.values}, {"lags_outside_band", c.lags_outside}};
+  };
+  ordered_json groups = ordered_json::array();
+  for (std::size_t g = 0; g < analysis.groups.size(); ++g) {
+    const auto& rc = analysis.groups[g];
+    if (!analysis.notes[g].empty()) {
+      groups.push_back({{"computed", false}, {"note", analysis.notes[g]}});
+      continue;
+    }
+    const bool truncated = g < analysis.truncated.size() && analysis.truncated[g];
+    ordered_json cross = ordered_json::array();
+    for (const auto& c : rc.cross) cross.push_back(curve(c));
+    groups.push_back({{"computed", true}, {"rows_used", truncated ? ordered_json(kMaxResidualRows) : ordered_json("all")}, {"n", rc.n}, {"segments", rc.segments}, {"max_lag", rc.max_lag},
+                      {"confidence_level", rc.confidence_level}, {"band", rc.band}, {"residuals_white", rc.residuals_white},
+                      {"verdict", rc.verdict}, {"autocorrelation", curve(rc.autocorrelation)}, {"cross_correlation", cross}});
+  }
+  return groups;
+}
+
+bool write_fit_pictures(const PictureContext& context, const PictureRequest& request, std::vector<std::string>& written,
+                        std::string& error) {
+  if (request.plots_directory.empty() && request.report_path.empty()) return true;
+  // Without --plots the report's figures are drawn in a scratch folder beside it and removed.
+  const bool scratch = request.plots_directory.empty();
+  fs::path directory = request.plots_directory;
+  std::error_code ec;
+  if (scratch) {
+    const fs::path report(request.report_path);
+    directory = (report.has_parent_path() ? report.parent_path() : fs::path(".")) / (report.filename().string() + ".figures.tmp");
+  }
+  fs::create_directories(directory, ec);
+  if (ec) {
+    error = fmt::format("error: cannot create `{}`: {}\nhint: choose a folder you can write to", directory.string(), ec.message());
+    return false;
+  }
+  ReportContent content = report_content(context);
+  std::vector<std::string> drawn;
+  bool ok = true;
+  for (const auto& [figure, group] : fit_figures(context)) {
+    const RenderSummary r = render_figure(figure, directory.string(), {});
+    if (!r.ok()) {
+      error = fmt::format("error: cannot draw figure `{}`: {}", figure.name, r.message);
+      ok = false;
+      break;
+    }
+    drawn.insert(drawn.end(), r.files.begin(), r.files.end());
+    if (request.report_path.empty()) continue;
+    std::string why;
+    ReportFigure f = report_figure_from_file(r.files.front(), figure.title, &why);
+    if (f.svg.empty()) {
+      error = fmt::format("error: cannot read back figure `{}`: {}", figure.name, why);
+      ok = false;
+      break;
+    }
+    if (group >= 0 && static_cast<std::size_t>(group) < content.groups.size()) content.groups[static_cast<std::size_t>(group)].figures.push_back(std::move(f));
+    else content.figures.push_back(std::move(f));
+  }
+  if (ok && !request.report_path.empty()) {
+    const ReportWriteSummary w = write_html_report(content, request.report_path);
+    if (!w.ok) {
+      error = fmt::format("error: cannot write `{}`: {}", request.report_path, w.message);
+      ok = false;
+    } else {
+      written.push_back(request.report_path);
+    }
+  }
+  if (scratch) {
+    fs::remove_all(directory, ec);
+  } else if (!ok) {
+    for (const auto& f : drawn) fs::remove(f, ec);  // no half set of pictures
+  } else {
+    written.insert(written.end(), drawn.begin(), drawn.end());
+  }
+  return ok;
+}
+
+}  // namespace sidc

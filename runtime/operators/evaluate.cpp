@@ -1,0 +1,256 @@
+#include "runtime/operators/evaluate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <fmt/format.h>
+
+#include "ir/queries.hpp"
+#include "ir/print.hpp"
+#include "diagnostics/data_catalogue.hpp"
+#include <stdexcept>
+
+namespace sidc {
+namespace {
+
+using ir::FactorKind;
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+std::size_t index_at_or_after(const std::vector<double>& time, double t) {
+  const double tolerance = 1e-9 * std::max(1.0, std::abs(t));
+  return static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), t - tolerance) - time.begin());
+}
+
+}  // namespace
+
+void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < guard.size(); ++i) {
+    if (std::isnan(lhs[i]) || std::isnan(rhs[i])) {
+      guard[i] = nan;
+      continue;
+    }
+    const bool holds = relation == ir::Relation::less ? lhs[i] < rhs[i]
+                     : relation == ir::Relation::less_equal ? lhs[i] <= rhs[i]
+                     : relation == ir::Relation::greater ? lhs[i] > rhs[i] : lhs[i] >= rhs[i];
+    if (!holds) guard[i] = 0.0;
+  }
+}
+
+void apply_function(const std::string& name, std::span<double> values) {
+  // A loop per function rather than a name comparison per sample (std:: functions may not be
+  // taken by address, so each gets its own loop).
+  auto each = [&](auto f) {
+    for (double& x : values) x = f(x);
+  };
+  if (name == "sin") each([](double x) { return std::sin(x); });
+  else if (name == "cos") each([](double x) { return std::cos(x); });
+  else if (name == "exp") each([](double x) { return std::exp(x); });
+  else if (name == "log") each([](double x) { return std::log(x); });
+  else if (name == "sqrt") each([](double x) { return std::sqrt(x); });
+  else if (name == "abs") each([](double x) { return std::abs(x); });
+  else if (name == "tanh") each([](double x) { return std::tanh(x); });
+  else each([](double x) { return std::isnan(x) ? x : static_cast<double>((x > 0) - (x < 0)); });  // sign
+}
+
+int highest_derivative_order(const ir::Model& model) {
+  int k = 0;
+  for (const auto& e : model.equations) k = std::max(k, derivative_burden(e));
+  return k;
+}
+
+std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, const ir::Model& model,
+                                               const EvaluationOptions& options, std::optional<double> from,
+                                               std::optional<double> to) {
+  const std::size_t n = record.time.size();
+  const int order = highest_derivative_order(model);
+  const std::size_t margin = order > 0 ? static_cast<std::size_t>(samples_lost_each_side(order, options.derivative)) : 0;
+  FitWindow w;
+  w.first = margin;
+  w.last = n > margin ? n - 1 - margin : 0;
+  if (from) w.first = std::max(w.first, index_at_or_after(record.time, *from));
+  if (to) {  // the last sample at or before `to` (0.82 itself when it is a sample)
+    const double tolerance = 1e-9 * std::max(1.0, std::abs(*to));
+    const auto past = static_cast<std::size_t>(std::upper_bound(record.time.begin(), record.time.end(), *to + tolerance) - record.time.begin());
+    if (past == 0) w.last = 0, w.first = 1;
+    else w.last = std::min(w.last, past - 1);
+  }
+  if (n <= 2 * margin || w.first > w.last) {
+    return data_diag::empty_fit_window(record.path, n, order, margin, from || to);
+  }
+  return w;
+}
+
+Evaluator::Evaluator(const SampledRecord& record, const ir::Model& model, const EvaluationOptions& options, FitWindow window)
+    : record_(record), model_(model), options_(options), window_(window) {}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::string& name, int order, const Span& where) {
+  const auto key = std::pair{name, order};
+  if (auto it = derivatives_.find(key); it != derivatives_.end()) return it->second;
+  const auto found = record_.signals.find(name);
+  if (found == record_.signals.end()) {
+    return diag::signal_not_in_record(where, name, record_.path);
+  }
+  if (order == 0) return derivatives_[key] = found->second;
+  auto estimate = estimate_derivative(found->second, record_.step, order, options_.derivative);
+  if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
+  return derivatives_[key] = std::get<Values>(std::move(estimate));
+}
+
+std::variant<double, Diagnostic> Evaluator::initial_value(const ir::Factor& f, const Span& where) {
+  const auto& time = record_.time;
+  std::size_t index = window_.first;
+  const std::string text = print(f);
+  if (f.at) {
+    const double t = f.at->value();
+    if (t < time.front() - 1e-9 || t > time.back() + 1e-9)
+      return diag::initial_value_outside_record(where, text, t, time.front(), time.back());
+    index = std::min(index_at_or_after(time, t), time.size() - 1);
+    auto values = signal(f.name, f.order, where);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const auto& v = std::get<Values>(values);
+    // Between two samples: linear interpolation.
+    if (index > 0 && std::abs(time[index] - t) > 1e-9 * std::max(1.0, std::abs(t))) {
+      const double a = (t - time[index - 1]) / (time[index] - time[index - 1]);
+      const double value = (1 - a) * v[index - 1] + a * v[index];
+      if (!std::isfinite(value)) return diag::initial_value_unavailable(where, text, t, record_.path);
+      return value;
+    }
+    if (!std::isfinite(v[index])) return diag::initial_value_unavailable(where, text, t, record_.path);
+    return v[index];
+  }
+  auto values = signal(f.name, f.order, where);
+  if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+  const double value = std::get<Values>(values)[index];
+  if (!std::isfinite(value)) return diag::initial_value_unavailable(where, text, time[index], record_.path);
+  return value;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor& f, const Span& where) {
+  const std::size_t n = record_.time.size();
+  switch (f.kind) {
+    case FactorKind::signal: return signal(f.name, f.order, where);
+    case FactorKind::time: return record_.time;
+    case FactorKind::elapsed: {
+      Values v(n);
+      const double t0 = record_.time[window_.first];
+      for (std::size_t i = 0; i < n; ++i) v[i] = record_.time[i] - t0;
+      return v;
+    }
+    case FactorKind::window_start: return Values(n, record_.time[window_.first]);
+    case FactorKind::initial_value: {
+      auto value = initial_value(f, where);
+      if (auto* d = std::get_if<Diagnostic>(&value)) return *d;
+      return Values(n, std::get<double>(value));
+    }
+    case FactorKind::function: {
+      auto argument = evaluate(*f.argument);
+      if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
+      Values v = std::get<Values>(std::move(argument));
+      apply_function(f.name, v);
+      return v;
+    }
+    case FactorKind::power: {
+      auto argument = evaluate(*f.argument);
+      if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
+      Values v = std::get<Values>(std::move(argument));
+      const double e = f.exponent.value();
+      for (double& x : v) x = std::pow(x, e);
+      return v;
+    }
+    case FactorKind::derivative:
+    case FactorKind::integral: {
+      const std::string key = print(f);
+      if (auto it = composite_.find(key); it != composite_.end()) return it->second;
+      auto argument = evaluate(*f.argument);
+      if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
+      const Values& a = std::get<Values>(argument);
+      Values v(n, nan);
+      if (f.kind == FactorKind::derivative) {
+        auto estimate = estimate_derivative(a, record_.step, f.order, options_.derivative);
+        if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
+        v = std::get<Values>(std::move(estimate));
+      } else {
+        // eq. 2-1.4: from t0 (the window's first sample) to t; Simpson's rule (section 3-2).
+        const std::span<const double> slice(a.data() + window_.first, window_.size());
+        auto integral = cumulative_integral(slice, record_.step, options_.integration);
+        if (auto* d = std::get_if<Diagnostic>(&integral)) return *d;
+        const Values& c = std::get<Values>(integral);
+        std::copy(c.begin(), c.end(), v.begin() + static_cast<std::ptrdiff_t>(window_.first));
+      }
+      return composite_[key] = std::move(v);
+    }
+    case FactorKind::guard: {
+      Values v(n, 1.0);
+      for (const auto& c : f.conditions) {
+        auto lhs = evaluate(*c.lhs);
+        if (auto* d = std::get_if<Diagnostic>(&lhs)) return *d;
+        auto rhs = evaluate(*c.rhs);
+        if (auto* d = std::get_if<Diagnostic>(&rhs)) return *d;
+        apply_condition(c.relation, std::get<Values>(lhs), std::get<Values>(rhs), v);
+      }
+      return v;
+    }
+    case FactorKind::parameter: break;
+  }
+  // normalize_pass takes every parameter out of the operations; one here is a bug (exit code 3).
+  throw std::logic_error("a parameter factor reached the evaluator");
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t) {
+  const std::size_t n = record_.time.size();
+  Values v(n, t.coefficient.value());
+  for (const auto& [f, power] : t.factors) {
+    auto values = factor(f, t.span);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& x = std::get<Values>(values);
+    if (f.kind == FactorKind::guard) {
+      // 0 * NaN would be NaN: a guard that is off zeroes the term even where the rest has no value
+      // (a derivative at the very edge), as eq. 4-1.9 defines the regions.
+      for (std::size_t i = 0; i < n; ++i) v[i] = x[i] == 0.0 ? 0.0 : v[i] * x[i];
+      continue;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      double p = x[i];
+      if (power == 2) p = p * p;
+      else if (power != 1) p = std::pow(p, power);
+      // A term already exactly zero stays zero where a later factor is infinite (x*y^-1 at
+      // x = y = 0 evaluates to 0, not NaN); NaN still spreads, so a missing value is never hidden.
+      if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;
+    }
+  }
+  return v;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate(const ir::Sum& s) {
+  Values total(record_.time.size(), 0.0);
+  for (const auto& t : s.terms) {
+    auto values = term(t);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& v = std::get<Values>(values);
+    for (std::size_t i = 0; i < total.size(); ++i) total[i] += v[i];
+  }
+  return total;
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate_in_window(const ir::Sum& s, const std::string& what) {
+  // Term by term, so that a value that is not finite is blamed on the term that made it.
+  Values total(window_.size(), 0.0);
+  for (const auto& t : s.terms) {
+    auto values = term(t);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& v = std::get<Values>(values);
+    for (std::size_t i = 0; i < window_.size(); ++i) {
+      const double x = v[window_.first + i];
+      if (!std::isfinite(x)) {
+        const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
+        return diag::operation_not_finite(t.span, print(single), what, record_.time[window_.first + i], record_.path);
+      }
+      total[i] += x;
+    }
+  }
+  return total;
+}
+
+}  // namespace sidc

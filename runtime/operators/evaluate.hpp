@@ -1,0 +1,97 @@
+// Evaluation of compiled operations on a sampled record, column by column (thesis chapter III).
+//
+// Relies on: a compiled model (ir/ir.hpp) and a record bound to its signals on a uniform
+// time grid. Guarantees: every factor is evaluated over the whole record — derivatives by the
+// moving-arc operator (eqs. 3-1.2 to 3-1.8), integrals by cumulative Simpson (or trapezoid) from
+// the window start t0 (eqs. 2-1.4, 2-2.5), products, powers, functions and guards sample by sample —
+// with NaN where a value does not exist (the edges a derivative loses, before t0 for an integral).
+// Each derivative and integral is computed once per record and reused. A value that is NaN or
+// infinite inside the fit window is reported with the source span of the operation that made it.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "ir/ir.hpp"
+#include "diagnostics/diagnostic.hpp"
+#include "runtime/operators/savitzky_golay.hpp"
+#include "runtime/operators/simpson.hpp"
+
+namespace sidc {
+
+// One record's signals on one uniform time grid.
+struct SampledRecord {
+  std::string path;                                    // for messages
+  double step = 0;
+  std::vector<double> time;                            // absolute times, time[k] = time[0] + k*step
+  std::map<std::string, std::vector<double>> signals;  // by signal name
+  std::map<std::string, std::string> columns;          // signal -> the column it came from (for messages)
+  std::vector<double> weights;                         // eq. 2-1.6: per sample; empty = all 1
+  std::string weights_column;
+};
+
+struct EvaluationOptions {
+  DerivativeOptions derivative;
+  IntegrationOptions integration;
+};
+
+// The rows a fit uses: [first, last] of the record, with t0 = time[first].
+struct FitWindow {
+  std::size_t first = 0;
+  std::size_t last = 0;  // inclusive
+  std::size_t size() const { return last >= first ? last - first + 1 : 0; }
+};
+
+// The highest order of derivative any operation of the model estimates (a der() of a derivative
+// adds up); the fit window keeps clear of the samples such derivatives lose at each edge.
+int highest_derivative_order(const ir::Model& model);
+
+// One condition of a guard (eq. 4-1.9's regions) sample by sample: where `lhs relation rhs` fails,
+// `guard` becomes 0; where either side is NaN (no value there), NaN. Shared by the whole-record
+// and block evaluators, so that both draw the regions' borders alike.
+void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard);
+
+// One of the language's functions (sin, cos, exp, log, sqrt, abs, sign, tanh) applied in place;
+// the name is resolved once, not per sample. Shared by the whole-record and block evaluators.
+void apply_function(const std::string& name, std::span<double> values);
+
+// The window the thesis uses: from the first sample with a full neighbourhood for every
+// derivative (t0 = 3*alpha*Delta for the 7-point operator applied alpha times, eq. 4-1.10) to the
+// last, cut to [from, to] when given. A Diagnostic when nothing is left.
+std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, const ir::Model& model,
+                                               const EvaluationOptions& options, std::optional<double> from,
+                                               std::optional<double> to);
+
+class Evaluator {
+ public:
+  Evaluator(const SampledRecord& record, const ir::Model& model, const EvaluationOptions& options, FitWindow window);
+
+  // The sum's value at every sample of the record; NaN where it has none.
+  std::variant<std::vector<double>, Diagnostic> evaluate(const ir::Sum& s);
+  // The same, cut to the fit window, with an error naming the term if a value in it is not finite;
+  // `what` says whose term it is ("the operation of `a1`", "the known side").
+  std::variant<std::vector<double>, Diagnostic> evaluate_in_window(const ir::Sum& s, const std::string& what);
+
+  const FitWindow& window() const { return window_; }
+  const SampledRecord& record() const { return record_; }
+
+ private:
+  using Values = std::vector<double>;
+  std::variant<Values, Diagnostic> term(const ir::Term& t);
+  std::variant<Values, Diagnostic> factor(const ir::Factor& f, const Span& where);
+  std::variant<Values, Diagnostic> signal(const std::string& name, int order, const Span& where);
+  std::variant<double, Diagnostic> initial_value(const ir::Factor& f, const Span& where);
+
+  const SampledRecord& record_;
+  const ir::Model& model_;
+  EvaluationOptions options_;
+  FitWindow window_;
+  std::map<std::pair<std::string, int>, Values> derivatives_;  // (signal, order) -> values
+  std::map<std::string, Values> composite_;                    // integrals and der() by printed text
+};
+
+}  // namespace sidc

@@ -1,0 +1,37 @@
+// A record read from a file, bound to a model's signals on one uniform time grid.
+//
+// Relies on: runtime/records/records.hpp (the file as columns) and the compiled model's data statement.
+// Guarantees: the time column (the one bound to `t`, else a column named `t` or `time`, else a
+// given step; a static model's rows are simply numbered) is uniformly sampled within tolerance, or the first bad row is named (`--resample`
+// interpolates onto a uniform grid instead); every signal without a definition is a complete
+// column; `every` keeps every k-th sample (the thesis' Delta = 0.020 from its Delta = 0.010 record);
+// inputs given as expressions of t are evaluated on the grid.
+#pragma once
+
+#include <optional>
+#include <variant>
+
+#include "ir/ir.hpp"
+#include "runtime/operators/evaluate.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/records/sampling.hpp"
+
+namespace sidc {
+
+struct BindOptions {
+  std::optional<double> step;      // sampling step when the record has no time column
+  std::optional<double> resample;  // interpolate linearly onto this step
+  int every = 1;                   // decimation
+  std::optional<std::string> weights;  // column of row weights (eq. 2-1.6)
+  UniformStepOptions uniform;
+};
+
+std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const ir::DataSource& source,
+                                                    const ir::Model& model, const BindOptions& options);
+
+// The same on a record the caller gives away: the columns used once are moved into the
+// SampledRecord, not copied (the record is left with those columns empty).
+std::variant<SampledRecord, Diagnostic> bind_record(Record&& record, const ir::DataSource& source, const ir::Model& model,
+                                                    const BindOptions& options);
+
+}  // namespace sidc

@@ -1,0 +1,493 @@
+#include "runtime/simulate/simulate.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <fmt/format.h>
+#include <stdexcept>
+
+#include "ir/differentiate.hpp"
+#include "diagnostics/data_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
+#include "runtime/operators/point_evaluator.hpp"
+#include "runtime/operators/savitzky_golay.hpp"
+
+namespace sidc {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+std::string prime(const std::string& name, int order) { return name + std::string(static_cast<std::size_t>(order), '\''); }
+
+// A ParametricSum with the parameter values substituted: sum_k weight_k * sum_k(point).
+struct Weighted {
+  std::vector<std::pair<double, PointSum>> parts;
+  double operator()(const PointInstant& at) const {
+    double v = 0;
+    for (const auto& [w, s] : parts) v += w * s.evaluate(at);
+    return v;
+  }
+};
+
+// The 4-point cubic through the samples around t (Lagrange form); the stencil shifts inward at
+// the ends of the grid. Exact for cubics, so the interpolation error is O(h^4), RK4's order.
+double interpolate_cubic(const std::vector<double>& time, const std::vector<double>& v, double t) {
+  const std::size_t n = time.size();
+  if (n == 1) return v[0];
+  auto upper = std::upper_bound(time.begin(), time.end(), t);
+  std::size_t k = upper == time.begin() ? 0 : static_cast<std::size_t>(upper - time.begin()) - 1;  // time[k] <= t
+  if (k >= n - 1) k = n - 2;
+  if (n < 4) {
+    const double a = (t - time[k]) / (time[k + 1] - time[k]);
+    return (1 - a) * v[k] + a * v[k + 1];
+  }
+  std::size_t first = k == 0 ? 0 : k - 1;
+  if (first + 3 >= n) first = n - 4;
+  double total = 0;
+  for (std::size_t i = first; i < first + 4; ++i) {
+    double w = 1;
+    for (std::size_t j = first; j < first + 4; ++j)
+      if (j != i) w *= (t - time[j]) / (time[i] - time[j]);
+    total += w * v[i];
+  }
+  return total;
+}
+
+class System {
+ public:
+  // Returns a Diagnostic when something of the model has no value at a point.
+  std::optional<Diagnostic> build(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& o) {
+    form_ = &form;
+    compile_options_.initial_value = o.initial_value;
+    options_ = &o;
+    auto weighted = [&](const ParametricSum& p, Weighted& out) -> std::optional<Diagnostic> {
+      auto add = [&](double w, const ir::Sum& s) -> std::optional<Diagnostic> {
+        if (s.empty() || w == 0) return std::nullopt;
+        auto c = compile_point_sum(s, layout_, compile_options_);
+        if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
+        out.parts.emplace_back(w, std::get<PointSum>(std::move(c)));
+        return std::nullopt;
+      };
+      if (auto d = add(1.0, p.constant)) return d;
+      for (const auto& t : p.terms)
+        if (auto d = add(o.parameters[static_cast<std::size_t>(t.parameter)], t.operation)) return d;
+      return std::nullopt;
+    };
+    const std::size_t k = form.outputs.size();
+    coefficient_.assign(k, std::vector<Weighted>(k));
+    rest_.assign(k, {});
+    for (std::size_t i = 0; i < k; ++i) {
+      for (std::size_t j = 0; j < k; ++j)
+        if (auto d = weighted(form.coefficient[i][j], coefficient_[i][j])) return d;
+      if (auto d = weighted(form.rest[i], rest_[i])) return d;
+    }
+    for (const auto& g : form.switching_functions) {
+      auto c = compile_point_sum(g, layout_, compile_options_);
+      if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
+      switching_.push_back(std::get<PointSum>(std::move(c)));
+    }
+    // Where each slot's value comes from: the state, an input definition or an input column.
+    std::size_t offset = 0;
+    for (const auto& out : form.outputs) {
+      state_offset_.push_back(offset);
+      offset += static_cast<std::size_t>(out.order);
+    }
+    for (std::size_t s = 0; s < layout_.size(); ++s) {
+      const auto& [name, order] = layout_.slots()[s];
+      Source source;
+      source.slot = s;
+      const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&](const auto& x) { return x.name == name; });
+      if (out != form.outputs.end()) {
+        source.kind = Source::Kind::state;
+        source.index = state_offset_[static_cast<std::size_t>(out - form.outputs.begin())] + static_cast<std::size_t>(order);
+      } else if (const ir::Signal* signal = model.signal(name); signal && signal->definition) {
+        auto derivative = order == 0 ? std::optional<ir::Sum>(*signal->definition) : differentiate(*signal->definition, order);
+        if (!derivative) return diag::simulate_estimated_derivative(signal->span, prime(name, order));
+        PointLayout none;
+        auto c = compile_point_sum(*derivative, none, compile_options_);
+        if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
+        source.kind = Source::Kind::definition;
+        source.definition = std::get<PointSum>(std::move(c));
+      } else {
+        auto column = o.inputs.find(name);
+        if (column == o.inputs.end())
+          return diag::signal_not_in_record(signal ? signal->span : Span{}, name, "the simulation's inputs");
+        source.kind = Source::Kind::column;
+        if (order == 0) {
+          source.column = column->second;
+        } else {  // a recorded input's derivative: the moving arc on the record, then interpolated
+          DerivativeOptions d;
+          d.edges = DerivativeOptions::Edges::shorten;
+          const double step = o.time.size() > 1 ? (o.time.back() - o.time.front()) / static_cast<double>(o.time.size() - 1) : 1.0;
+          auto estimate = estimate_derivative(column->second, step, order, d);
+          if (auto* e = std::get_if<Diagnostic>(&estimate)) return *e;
+          source.column = std::get<std::vector<double>>(std::move(estimate));
+        }
+      }
+      sources_.push_back(std::move(source));
+    }
+    slots_.assign(layout_.size(), 0.0);
+    return std::nullopt;
+  }
+
+  std::size_t state_size() const { return form_->state_size(); }
+
+  void fill(double t, const double* state) {
+    for (const auto& s : sources_) {
+      double v = 0;
+      switch (s.kind) {
+        case Source::Kind::state: v = state[s.index]; break;
+        case Source::Kind::definition: v = s.definition.evaluate({std::span<const double>(), t, options_->t0_for_tau}); break;
+        case Source::Kind::column: v = interpolate_cubic(options_->time, s.column, t); break;
+      }
+      slots_[s.slot] = v;
+    }
+  }
+
+  PointInstant instant(double t) const { return {slots_, t, options_->t0_for_tau}; }
+
+  // dstate/dt; false (and `trouble` set) when the highest derivatives cannot be solved for.
+  bool derivative(double t, const double* state, double* out) {
+    ++evaluations;
+    fill(t, state);
+    const PointInstant at = instant(t);
+    const std::size_t k = form_->outputs.size();
+    for (std::size_t j = 0; j < k; ++j) {  // y^(m)' = y^(m+1) for m < n-1
+      const std::size_t base = state_offset_[j];
+      for (int m = 0; m + 1 < form_->outputs[j].order; ++m) out[base + static_cast<std::size_t>(m)] = state[base + static_cast<std::size_t>(m) + 1];
+    }
+    double det = 0;
+    if (k == 1) {
+      const double a = coefficient_[0][0](at), r = rest_[0](at);
+      det = a;
+      out[state_offset_[0] + static_cast<std::size_t>(form_->outputs[0].order) - 1] = -r / a;
+    } else {
+      Eigen::MatrixXd a(k, k);
+      Eigen::VectorXd r(k);
+      for (std::size_t i = 0; i < k; ++i) {
+        for (std::size_t j = 0; j < k; ++j) a(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = coefficient_[i][j](at);
+        r(static_cast<Eigen::Index>(i)) = rest_[i](at);
+      }
+      Eigen::PartialPivLU<Eigen::MatrixXd> lu(a);
+      det = lu.determinant();
+      const Eigen::VectorXd z = lu.solve(-r);
+      for (std::size_t j = 0; j < k; ++j)
+        out[state_offset_[j] + static_cast<std::size_t>(form_->outputs[j].order) - 1] = z(static_cast<Eigen::Index>(j));
+    }
+    // eq. 4-1.1 divided by m: a coefficient that vanishes or changes sign on the way makes the
+    // highest derivative infinite or the equation a different one; stop there.
+    if (!initial_det_) initial_det_ = det;
+    last_det_ = det;
+    if (!std::isfinite(det) || std::abs(det) <= 1e-12 * std::abs(*initial_det_) || (det > 0) != (*initial_det_ > 0)) {
+      if (!trouble) singular_at(t);
+      return false;
+    }
+    return true;
+  }
+
+  // The adaptive stepper stalls before the coefficient is exactly 0: a coefficient below 1e-6 of
+  // its start where it stalls is the reason.
+  bool nearly_singular() const { return initial_det_ && std::abs(last_det_) < 1e-6 * std::abs(*initial_det_); }
+
+  void singular_at(double t) {
+    trouble_time = t;
+    const std::size_t k = form_->outputs.size();
+    const std::string what = k == 1 ? fmt::format("the coefficient of `{}`", prime(form_->outputs[0].name, form_->outputs[0].order))
+                                    : std::string("the determinant of the coefficients of the highest derivatives");
+    trouble = fmt::format("{} is {:.6g} at t = {:.6g} (it was {:.6g} at the start): it vanishes or changes sign on the trajectory, "
+                          "so the equation cannot be solved for the highest derivative there",
+                          what, last_det_, t, initial_det_.value_or(0.0));
+  }
+
+  // The switching functions' values at (t, state).
+  void switching_values(double t, const double* state, std::vector<double>& g) {
+    g.resize(switching_.size());
+    if (switching_.empty()) return;
+    fill(t, state);
+    const PointInstant at = instant(t);
+    for (std::size_t i = 0; i < switching_.size(); ++i) g[i] = switching_[i].evaluate(at);
+  }
+  bool has_switches() const { return !switching_.empty(); }
+
+  std::vector<std::size_t> state_offset_;
+  std::size_t evaluations = 0;
+  std::optional<std::string> trouble;
+  double trouble_time = 0;
+
+ private:
+  struct Source {
+    enum class Kind { state, definition, column } kind = Kind::state;
+    std::size_t slot = 0, index = 0;
+    PointSum definition;
+    std::vector<double> column;
+  };
+  const ExplicitForm* form_ = nullptr;
+  const SimulateOptions* options_ = nullptr;
+  PointLayout layout_;
+  PointCompileOptions compile_options_;
+  std::vector<std::vector<Weighted>> coefficient_;
+  std::vector<Weighted> rest_;
+  std::vector<PointSum> switching_;
+  std::vector<Source> sources_;
+  std::vector<double> slots_;
+  std::optional<double> initial_det_;
+  double last_det_ = 0;
+};
+
+using State = std::vector<double>;
+
+// One classic RK4 step (the thesis' solver, Ralston and Wilf pp. 110-120).
+bool rk4_step(System& system, double t, const State& s, double h, State& out, State (&k)[4], State& tmp) {
+  const std::size_t n = s.size();
+  if (!system.derivative(t, s.data(), k[0].data())) return false;
+  for (std::size_t i = 0; i < n; ++i) tmp[i] = s[i] + 0.5 * h * k[0][i];
+  if (!system.derivative(t + 0.5 * h, tmp.data(), k[1].data())) return false;
+  for (std::size_t i = 0; i < n; ++i) tmp[i] = s[i] + 0.5 * h * k[1][i];
+  if (!system.derivative(t + 0.5 * h, tmp.data(), k[2].data())) return false;
+  for (std::size_t i = 0; i < n; ++i) tmp[i] = s[i] + h * k[2][i];
+  if (!system.derivative(t + h, tmp.data(), k[3].data())) return false;
+  for (std::size_t i = 0; i < n; ++i) out[i] = s[i] + h / 6.0 * (k[0][i] + 2 * k[1][i] + 2 * k[2][i] + k[3][i]);
+  return true;
+}
+
+bool any_sign_change(const std::vector<double>& a, const std::vector<double>& b) {
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i] * b[i] < 0) return true;
+  return false;
+}
+
+// The first offending state component, or nullopt when the state is fine.
+std::optional<std::string> divergence(const State& s, const ExplicitForm& form, const std::vector<std::size_t>& offsets, double bound, double t) {
+  for (std::size_t j = 0; j < form.outputs.size(); ++j)
+    for (int m = 0; m < form.outputs[j].order; ++m) {
+      const double v = s[offsets[j] + static_cast<std::size_t>(m)];
+      const std::string name = prime(form.outputs[j].name, m);
+      if (!std::isfinite(v)) return fmt::format("the simulation diverged: `{}` is not finite at t = {:.6g}", name, t);
+      if (std::abs(v) > bound)
+        return fmt::format("the simulation diverged: |{}| = {:.3g} exceeds {:.3g} at t = {:.6g}", name, std::abs(v), bound, t);
+    }
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool SimulateOptions::is_valid(std::string* why) const {
+  auto fail = [&](std::string text) {
+    if (why) *why = std::move(text);
+    return false;
+  };
+  if (substeps < 1) return fail("substeps must be at least 1");
+  if (!(absolute_tolerance > 0) || !(relative_tolerance >= 0)) return fail("tolerances must be positive");
+  if (time.empty()) return fail("no time grid to simulate on");
+  for (std::size_t i = 1; i < time.size(); ++i)
+    if (!(time[i] > time[i - 1])) return fail(fmt::format("the time grid does not increase at t = {}", time[i]));
+  for (const auto& [name, v] : inputs)
+    if (v.size() != time.size()) return fail(fmt::format("input `{}` has {} values for {} times", name, v.size(), time.size()));
+  if (!(divergence_bound > 0)) return fail("the divergence bound must be positive");
+  return true;
+}
+
+std::string SimulationSummary::brief_report() const {
+  const double first = time.empty() ? 0.0 : time.front(), last = time.empty() ? 0.0 : time.back();
+  std::string out = status == Status::completed ? fmt::format("simulation: completed from t = {:.6g} to {:.6g}", first, last)
+                                                : fmt::format("simulation: stopped at t = {:.6g} (of {:.6g} to {:.6g})", stopped_at.value_or(first), first, last);
+  out += fmt::format(", {} steps, {} evaluations of the equations", steps, right_hand_sides);
+  if (switches) out += fmt::format(", {} guard switches located", switches);
+  return out;  // `message` says why it stopped; callers print it as an error or a statement
+}
+
+std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& o) {
+  // Options are the caller's to check (SimulateOptions::is_valid): a bad one here is a bug.
+  if (std::string why; !o.is_valid(&why)) throw std::logic_error("simulate: " + why);
+  if (o.parameters.size() != normalized.parameters.size())
+    throw std::logic_error(fmt::format("simulate: {} parameter values for {} parameters", o.parameters.size(), normalized.parameters.size()));
+  System system;
+  if (auto d = system.build(normalized, form, o)) return *d;
+  SimulationSummary summary;
+  summary.time = o.time;
+  const std::size_t n = o.time.size();
+  for (const auto& out : form.outputs) {
+    summary.output_names.push_back(out.name);
+    summary.outputs.emplace_back(n, nan);
+  }
+  State s(system.state_size(), 0.0);
+  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+    auto it = o.initial.find(form.outputs[j].name);
+    for (int m = 0; m < form.outputs[j].order; ++m)
+      s[system.state_offset_[j] + static_cast<std::size_t>(m)] =
+          it != o.initial.end() && static_cast<std::size_t>(m) < it->second.size() ? it->second[static_cast<std::size_t>(m)] : 0.0;
+  }
+  auto record = [&](std::size_t row, const State& x) {
+    for (std::size_t j = 0; j < form.outputs.size(); ++j) summary.outputs[j][row] = x[system.state_offset_[j]];
+  };
+  auto stop = [&](SimulationSummary::Status status, std::string message, double t) {
+    summary.status = status;
+    summary.message = std::move(message);
+    summary.stopped_at = t;
+  };
+  record(0, s);
+  if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, o.time[0])) {
+    stop(SimulationSummary::Status::diverged, *bad, o.time[0]);
+    return summary;
+  }
+
+  if (o.method == SimulateOptions::Method::rk4) {
+    State next(s.size()), tmp(s.size()), trial(s.size());
+    State k[4] = {State(s.size()), State(s.size()), State(s.size()), State(s.size())};
+    std::vector<double> g0, g1;
+    const bool locate = o.locate_switches && system.has_switches();
+    for (std::size_t row = 1; row < n; ++row) {
+      const double h = (o.time[row] - o.time[row - 1]) / o.substeps;
+      for (int sub = 0; sub < o.substeps; ++sub) {
+        double t = o.time[row - 1] + sub * h;
+        const double end = sub + 1 == o.substeps ? o.time[row] : t + h;
+        int located = 0;
+        while (t < end) {
+          double step = end - t;
+          bool ok = rk4_step(system, t, s, step, next, k, tmp);
+          if (ok && locate && located < 16) {
+            system.switching_values(t, s.data(), g0);
+            system.switching_values(t + step, next.data(), g1);
+            if (any_sign_change(g0, g1)) {
+              // Bisection on the step length: the shortest step after which a guard has switched.
+              double lo = 0, hi = step;
+              while (hi - lo > 1e-13 * std::max(1.0, std::abs(t)) && ok) {
+                const double mid = 0.5 * (lo + hi);
+                ok = rk4_step(system, t, s, mid, trial, k, tmp);
+                system.switching_values(t + mid, trial.data(), g1);
+                (any_sign_change(g0, g1) ? hi : lo) = mid;
+              }
+              if (ok) ok = rk4_step(system, t, s, hi, next, k, tmp);
+              step = hi;
+              ++located;
+              ++summary.switches;
+            }
+          }
+          if (!ok) {
+            stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
+            summary.right_hand_sides = system.evaluations;
+            return summary;
+          }
+          s.swap(next);
+          t = step == end - t ? end : t + step;
+          ++summary.steps;
+          if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
+            stop(SimulationSummary::Status::diverged, *bad, t);
+            summary.right_hand_sides = system.evaluations;
+            return summary;
+          }
+        }
+      }
+      record(row, s);
+    }
+  } else {
+    namespace odeint = boost::numeric::odeint;
+    auto rhs = [&](const State& x, State& dx, double t) {
+      if (!system.derivative(t, x.data(), dx.data())) std::fill(dx.begin(), dx.end(), nan);
+    };
+    const double first_step = n > 1 ? (o.time[1] - o.time[0]) / 10 : 1e-3;
+    // An adaptive stepper creeping towards a singularity takes ever smaller steps and never
+    // arrives: below this step it has found one.
+    auto minimum_step = [&](double t) { return 1e-12 * std::max({1.0, std::abs(t), std::abs(o.time.back() - o.time.front())}); };
+    auto too_small = [&](double t) {
+      if (system.nearly_singular()) {
+        system.singular_at(t);
+        return *system.trouble;
+      }
+      return fmt::format("the simulation diverged: the adaptive stepper's step fell below 1e-12 of the time span at t = {:.6g} "
+                         "(the solution is singular or extremely stiff there)", t);
+    };
+    try {
+      if (o.stepper == SimulateOptions::Stepper::dopri5) {
+        auto stepper = odeint::make_dense_output(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_dopri5<State>());
+        stepper.initialize(s, o.time[0], first_step);
+        for (std::size_t row = 1; row < n; ++row) {
+          while (stepper.current_time() < o.time[row]) {
+            stepper.do_step(rhs);
+            ++summary.steps;
+            if (stepper.current_time_step() < minimum_step(stepper.current_time()) && stepper.current_time() < o.time[row]) {
+              const std::string why = too_small(stepper.current_time());
+              stop(system.trouble ? SimulationSummary::Status::singular : SimulationSummary::Status::diverged, why, stepper.current_time());
+              summary.right_hand_sides = system.evaluations;
+              return summary;
+            }
+            if (system.trouble) {
+              stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
+              summary.right_hand_sides = system.evaluations;
+              return summary;
+            }
+            if (auto bad = divergence(stepper.current_state(), form, system.state_offset_, o.divergence_bound, stepper.current_time())) {
+              stop(SimulationSummary::Status::diverged, *bad, stepper.current_time());
+              summary.right_hand_sides = system.evaluations;
+              return summary;
+            }
+          }
+          stepper.calc_state(o.time[row], s);
+          record(row, s);
+        }
+      } else {
+        auto stepper = odeint::make_controlled(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_cash_karp54<State>());
+        double t = o.time[0], dt = first_step;
+        for (std::size_t row = 1; row < n; ++row) {
+          while (t < o.time[row]) {
+            if (t + dt > o.time[row]) dt = o.time[row] - t;
+            if (stepper.try_step(rhs, s, t, dt) == odeint::success) {
+              ++summary.steps;
+            } else if (dt < minimum_step(t)) {
+              const std::string why = too_small(t);
+              stop(system.trouble ? SimulationSummary::Status::singular : SimulationSummary::Status::diverged, why, t);
+              summary.right_hand_sides = system.evaluations;
+              return summary;
+            }
+            if (system.trouble) {
+              stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
+              summary.right_hand_sides = system.evaluations;
+              return summary;
+            }
+            if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
+              stop(SimulationSummary::Status::diverged, *bad, t);
+              summary.right_hand_sides = system.evaluations;
+              return summary;
+            }
+          }
+          t = o.time[row];
+          record(row, s);
+        }
+      }
+    } catch (const std::exception& e) {  // Odeint gives up when no step size satisfies the tolerance
+      const double t = system.evaluations ? system.trouble_time : o.time[0];
+      if (system.trouble) stop(SimulationSummary::Status::singular, *system.trouble, t);
+      else stop(SimulationSummary::Status::diverged, fmt::format("the simulation diverged: the adaptive stepper found no step size meeting the tolerance ({})", e.what()), t);
+    }
+  }
+  summary.right_hand_sides = system.evaluations;
+  return summary;
+}
+
+std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_state_from_record(const ExplicitForm& form,
+                                                                                              const SampledRecord& record,
+                                                                                              const DerivativeOptions& derivative,
+                                                                                              std::size_t index) {
+  std::map<std::string, std::vector<double>> initial;
+  DerivativeOptions d = derivative;
+  d.edges = DerivativeOptions::Edges::shorten;
+  for (const auto& out : form.outputs) {
+    auto column = record.signals.find(out.name);
+    if (column == record.signals.end()) return diag::signal_not_in_record(out.span, out.name, record.path);
+    std::vector<double> values;
+    for (int m = 0; m < out.order; ++m) {
+      if (m == 0) {
+        values.push_back(column->second[index]);
+        continue;
+      }
+      auto estimate = estimate_derivative(column->second, record.step, m, d);
+      if (auto* e = std::get_if<Diagnostic>(&estimate)) return *e;
+      values.push_back(std::get<std::vector<double>>(estimate)[index]);
+    }
+    initial[out.name] = std::move(values);
+  }
+  return initial;
+}
+
+}  // namespace sidc

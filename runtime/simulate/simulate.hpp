@@ -1,0 +1,84 @@
+// Simulation: the model's equations solved forward in time with given parameter values (thesis
+// section 2-4, "solving the system equation"; Appendix A was made this way with fourth-order
+// Runge-Kutta, footnote to eq. 4-1.3).
+//
+// Relies on: compiler/explicit_form_pass.hpp (the equations solved for each output's highest
+// derivative, parameters symbolic), runtime/operators/point_evaluator.hpp, Boost.Odeint (adaptive method).
+// Guarantees: the state is (y, y', ..., y^(n-1)) per output; at each instant the k x k linear
+// system of the highest derivatives is solved (k = 1: a division). Methods: classic fixed-step
+// RK4 with `substeps` steps per output interval, guard switches located by bisection on the
+// switching functions and stepped to exactly (so a branch change never falls inside a step); or
+// Odeint's dopri5 / cash_karp with absolute and relative tolerances (the adaptive controller
+// shrinks its steps at a switch but does not locate it). Inputs bound to record columns are
+// interpolated between samples by the 4-point cubic through the neighbouring samples (RK4 needs
+// the input at half steps; linear interpolation would cap RK4's order at 2), inputs defined by
+// an expression of t are evaluated exactly. Nothing aborts: a state that is not finite or
+// exceeds `divergence_bound`, or a coefficient matrix of the highest derivatives that becomes
+// singular or changes the sign of its determinant, stops the run with a status, the time and a
+// plain sentence; outputs after that time are NaN.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "ir/explicit_form.hpp"
+#include "runtime/operators/evaluate.hpp"
+
+namespace sidc {
+
+struct SimulateOptions {
+  enum class Method { rk4, adaptive };
+  Method method = Method::rk4;
+  int substeps = 1;  // rk4: steps per interval of the output grid
+  enum class Stepper { dopri5, cash_karp };
+  Stepper stepper = Stepper::dopri5;
+  double absolute_tolerance = 1e-9, relative_tolerance = 1e-9;  // adaptive
+  bool locate_switches = true;                                  // rk4: step to each guard switch
+  double divergence_bound = 1e8;  // |state| beyond this is divergence
+
+  std::vector<double> parameters;  // by index into the normalized model's parameters
+  // Initial state per output: y(t0), y'(t0), ..., y^(n-1)(t0) (n values, the output's order).
+  std::map<std::string, std::vector<double>> initial;
+  std::vector<double> time;  // the output grid, increasing, time[0] = t0; uniform not required
+  // Inputs without a definition: samples on `time` (a record's columns).
+  std::map<std::string, std::vector<double>> inputs;
+  double t0_for_tau = 0;  // the window start `t0` (and tau = t - t0) as the model means it; usually time[0]
+  // The value of an initial-value factor such as `y2(0)` (eq. 4-2.4's constants=initial form);
+  // unset, or nullopt from it: the model cannot be simulated (a Diagnostic at the term).
+  std::function<std::optional<double>(const ir::Factor&)> initial_value;
+
+  bool is_valid(std::string* why) const;
+};
+
+struct SimulationSummary {
+  enum class Status { completed, diverged, singular };
+  Status status = Status::completed;
+  std::string message;                 // one plain sentence; empty when completed
+  std::optional<double> stopped_at;    // when it diverged or became singular
+  std::size_t steps = 0;               // accepted steps (rk4: including partial steps at switches)
+  std::size_t switches = 0;            // guard switches located (rk4)
+  std::size_t right_hand_sides = 0;    // evaluations of the equations
+  std::vector<double> time;
+  std::vector<std::string> output_names;
+  std::vector<std::vector<double>> outputs;  // per output, on `time`; NaN after stopped_at
+  bool completed() const { return status == Status::completed; }
+  std::string brief_report() const;
+};
+
+// Compiles the explicit form for point evaluation and runs the simulation. Diagnostics are for
+// the model (an input with no values, a term that has no value at a point); numerical trouble is
+// a status in the summary.
+std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options);
+
+// y(t), y'(t), ..., y^(n-1)(t) of each output at sample `index` of a record, derivatives by the
+// moving arc with off-centre (shortened) windows at the edges, so the first sample has them.
+std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_state_from_record(const ExplicitForm& form,
+                                                                                              const SampledRecord& record,
+                                                                                              const DerivativeOptions& derivative,
+                                                                                              std::size_t index);
+
+}  // namespace sidc

@@ -8,12 +8,12 @@
 #include <iostream>
 
 #include "cli/exit_codes.hpp"
-#include "cli/read_file.hpp"
 #include "report/atomic_file.hpp"
 #include "ir/compiled_model.hpp"
 #include "compiler/pipeline.hpp"
 #include "ir/print.hpp"
 #include "grammar/ast_printer.hpp"
+#include "diagnostics/cli_catalogue.hpp"
 #include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
@@ -69,10 +69,9 @@ std::string summary(const ir::Model& m, const std::string& path) {
 }
 
 int run_compile(const CompileArguments& a) {
-  std::string error;
-  auto text = read_whole_file(a.model, error);
-  if (!text) {
-    std::cerr << error << "\nhint: give the path of a model file, e.g. `sidc compile examples/thesis-4-1/quasi_linear.sid`\n";
+  auto text = read_text_file(a.model);
+  if (auto* d = std::get_if<Diagnostic>(&text)) {
+    std::cerr << render(cli_diag::model_not_read(*d)) << "\n";
     return exit_code::user_error;
   }
   CompileOptions options;
@@ -97,7 +96,7 @@ int run_compile(const CompileArguments& a) {
     if (!stop) return exit_code::usage_error;
     options.stop_after = *stop;
   }
-  auto source = std::make_shared<const SourceFile>(a.model, std::move(*text));
+  auto source = std::make_shared<const SourceFile>(a.model, std::get<std::string>(std::move(text)));
   CompileResult r = compile(source, options);
   std::cerr << r.diagnostics.render_all();
   if (!r.ok()) return exit_code::user_error;
@@ -123,8 +122,8 @@ int run_compile(const CompileArguments& a) {
     if (std::filesystem::path(d.path).is_relative())
       d.path = (model_dir / d.path).lexically_normal().lexically_relative(output_dir).string();
   const std::string json = to_json(CompiledModel{source, *r.normalized, written, std::nullopt}).dump(1) + "\n";
-  if (!write_file_atomically(output, json, &error)) {
-    std::cerr << "error: " << error << "\nhint: choose a writable place with `-o FILE`\n";
+  if (std::string why; !write_file_atomically(output, json, &why)) {
+    std::cerr << render(cli_diag::cannot_write(why, "choose a writable place with `-o FILE`")) << "\n";
     return exit_code::user_error;
   }
   std::cerr << "wrote " << output << "\n";

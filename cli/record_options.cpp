@@ -6,8 +6,10 @@
 #include <fmt/format.h>
 
 #include "ir/settings.hpp"
-#include "diagnostics/model_catalogue.hpp"
+#include "diagnostics/cli_catalogue.hpp"
+#include "diagnostics/data_catalogue.hpp"
 #include "runtime/records/records.hpp"
+#include "runtime/solve/options_from_settings.hpp"
 
 namespace sidc {
 namespace fs = std::filesystem;
@@ -43,37 +45,35 @@ void add_record_options(CLI::App* cmd, RecordArguments& a) {
   cmd->add_option("--weights", a.weights, "A record column weighting each row's residual (eq. 2-1.6)");
 }
 
-std::optional<FitOptions> fit_options(const ir::Model& model, const RecordArguments& a, std::string& error) {
-  const EvaluationSettings e = evaluation_settings(model.settings);
-  FitOptions o;
-  MovingArc arc = e.derivative;
+std::optional<EvaluationSettings> evaluation_settings(const ir::Model& model, const RecordArguments& a, std::string& error) {
+  EvaluationSettings e = evaluation_settings(model.settings);
   if (!a.derivative.empty()) {
     auto parsed = parse_moving_arc(a.derivative);
     if (!parsed) {
-      error = fmt::format("error: `--derivative {}` is not a moving-arc operator\nhint: write e.g. `--derivative \"savgol(7, 3)\"`", a.derivative);
+      error = render(cli_diag::not_a_moving_arc(a.derivative));
       return std::nullopt;
     }
-    arc = *parsed;
+    e.derivative = *parsed;
   }
-  o.evaluation.derivative.window = arc.window;
-  o.evaluation.derivative.polyorder = arc.order;
-  bool repeated = e.second_derivative_repeated, shorten = e.shorten_edges, trapezoid = e.trapezoid;
-  if (!a.second_derivative.empty()) repeated = a.second_derivative == "repeated";
-  if (!a.edges.empty()) shorten = a.edges == "shorten";
-  if (!a.integration.empty()) trapezoid = a.integration == "trapezoid";
-  o.evaluation.derivative.second = repeated ? DerivativeOptions::Second::repeated : DerivativeOptions::Second::direct;
-  o.evaluation.derivative.edges = shorten ? DerivativeOptions::Edges::shorten : DerivativeOptions::Edges::drop;
-  o.evaluation.integration.rule = trapezoid ? IntegrationOptions::Rule::trapezoid : IntegrationOptions::Rule::simpson;
-  if (e.smooth_before_integration) {
-    o.evaluation.integration.smoothing_window = e.smooth_before_integration->window;
-    o.evaluation.integration.smoothing_polyorder = e.smooth_before_integration->order;
-  }
-  o.from = a.from ? a.from : e.from;
-  o.to = a.to ? a.to : e.to;
+  if (!a.second_derivative.empty()) e.second_derivative_repeated = a.second_derivative == "repeated";
+  if (!a.edges.empty()) e.shorten_edges = a.edges == "shorten";
+  if (!a.integration.empty()) e.trapezoid = a.integration == "trapezoid";
+  if (a.from) e.from = a.from;
+  if (a.to) e.to = a.to;
+  if (a.every) e.every = *a.every;
+  if (a.step) e.step = a.step;
+  if (!a.weights.empty()) e.weights = a.weights;
+  return e;
+}
+
+std::optional<FitOptions> fit_options(const ir::Model& model, const RecordArguments& a, std::string& error) {
+  auto settings = evaluation_settings(model, a, error);
+  if (!settings) return std::nullopt;
+  FitOptions o = fit_options(*settings);
   if (a.precision == "double") o.least_squares.precision = Precision::double_precision;
   if (a.precision == "extended") o.least_squares.precision = Precision::extended;
-  if (!o.is_valid(&error)) {
-    error = "error: " + error;
+  if (std::string why; !o.is_valid(&why)) {
+    error = render(cli_diag::invalid_options(why));
     return std::nullopt;
   }
   return o;
@@ -116,12 +116,10 @@ std::optional<LoadedRecords> load_records(const CompiledModel& compiled, const s
     error = render(diag::no_data_file(Span{compiled.source, 0, 0}));
     return std::nullopt;
   }
-  const EvaluationSettings e = evaluation_settings(model.settings);
-  out.bind.every = a.every.value_or(e.every);
-  out.bind.step = a.step ? a.step : e.step;
+  auto settings = evaluation_settings(model, a, error);
+  if (!settings) return std::nullopt;
+  out.bind = bind_options(*settings);
   out.bind.resample = a.resample;
-  if (!a.weights.empty()) out.bind.weights = a.weights;
-  else out.bind.weights = e.weights;
   for (const auto& s : out.sources) {
     auto record = read_csv(s.path);
     if (auto* d = std::get_if<Diagnostic>(&record)) {

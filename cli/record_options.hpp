@@ -1,7 +1,8 @@
 // What `sidc fit` and `sidc select` share: the options that say which records to read and how to
 // evaluate the model on them, turned into FitOptions and bound SampledRecords the same way for both.
 //
-// Relies on: the model's settings (ir/settings.hpp), which the options override one by one.
+// Relies on: the model's settings (ir/settings.hpp), which the options override one by one, and
+// runtime/solve/options_from_settings.hpp, the one translation of settings into runtime options.
 // Guarantees: the records are the command line's `--data` files (bound as the model's first data
 // statement), else the model's data statements, with relative paths taken from the compiled
 // model's folder; every problem comes back as a message for stderr and an exit code, never an
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "ir/compiled_model.hpp"
+#include "ir/settings.hpp"
 #include "runtime/records/bind_record.hpp"
 #include "runtime/solve/fit.hpp"
 
@@ -31,6 +33,8 @@ struct RecordArguments {
 void add_record_options(CLI::App* command, RecordArguments& arguments);
 
 // The model's settings overridden by the command line; nullopt with `error` (a usage error).
+std::optional<EvaluationSettings> evaluation_settings(const ir::Model& model, const RecordArguments& arguments, std::string& error);
+// The same, translated (runtime/solve/options_from_settings.hpp), with --precision.
 std::optional<FitOptions> fit_options(const ir::Model& model, const RecordArguments& arguments, std::string& error);
 
 struct LoadedRecords {

@@ -1,8 +1,10 @@
 // `sidc simulate`: argument parsing and printing only. The model is solved for its highest
 // derivatives by compiler/explicit_form_pass.cpp and integrated by runtime/simulate/simulate.cpp.
 //
-// Relies on: cli/fit_command.hpp (loading a model), runtime/records/bind_record.hpp (a record on its
-// uniform grid). Guarantees: every bad option is a one-line `error:` with a `hint:` and exit code 2
+// Relies on: compiler/load_model.hpp, runtime/records/bind_record.hpp (a record on its uniform grid),
+// runtime/solve/options_from_settings.hpp (the model's settings, read as `sidc fit` reads them),
+// report/simulation_file.hpp (the CSV), diagnostics/cli_catalogue.hpp (every message). Guarantees:
+// every bad option is a one-line `error:` with a `hint:` and exit code 2
 // (command line) or 1 (model, record, numbers); the CSV has the record's column names (the time
 // column and each output's bound column) and is written atomically; a run that diverges still
 // writes its CSV (NaN after the stop) and exits 1 with the sentence saying where.
@@ -16,12 +18,15 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/exit_codes.hpp"
-#include "cli/fit_command.hpp"
-#include "cli/read_file.hpp"
-#include "report/atomic_file.hpp"
+#include "compiler/load_model.hpp"
+#include "diagnostics/cli_catalogue.hpp"
 #include "ir/settings.hpp"
+#include "report/atomic_file.hpp"
+#include "report/simulation_file.hpp"
 #include "runtime/records/bind_record.hpp"
+#include "runtime/records/records.hpp"
 #include "runtime/simulate/simulate.hpp"
+#include "runtime/solve/options_from_settings.hpp"
 
 namespace sidc {
 namespace {
@@ -57,13 +62,12 @@ struct Failure {
 std::variant<std::pair<std::string, double>, Failure> name_value(const std::string& text, const char* option, const char* example) {
   const auto eq = text.find('=');
   if (eq == std::string::npos || eq == 0)
-    return Failure{exit_code::usage_error, fmt::format("error: `{} {}` is not NAME=VALUE\nhint: write e.g. `{} {}`", option, text, option, example)};
+    return Failure{exit_code::usage_error, render(cli_diag::not_name_value(option, text, example))};
   std::string name = text.substr(0, eq);
   while (!name.empty() && name.back() == ' ') name.pop_back();
   auto value = parse_number(std::string_view(text).substr(eq + 1));
   if (!value)
-    return Failure{exit_code::usage_error,
-                   fmt::format("error: `{} {}`: `{}` is not a finite number\nhint: write e.g. `{} {}`", option, text, text.substr(eq + 1), option, example)};
+    return Failure{exit_code::usage_error, render(cli_diag::value_not_finite(option, text, text.substr(eq + 1), example))};
   return std::pair{name, *value};
 }
 
@@ -75,7 +79,7 @@ std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& mod
       if (from_file) return std::nullopt;  // an integration constant of an integrated fit: not needed
       std::string names;
       for (const auto& p : model.parameters) names += (names.empty() ? "" : ", ") + p.name;
-      return Failure{exit_code::usage_error, fmt::format("error: `--param {}=...`: the model has no parameter `{}`\nhint: its parameters are {}", name, name, names)};
+      return Failure{exit_code::usage_error, render(cli_diag::no_such_parameter(name, names))};
     }
     values[static_cast<std::size_t>(index)] = v;
     return std::nullopt;
@@ -86,7 +90,7 @@ std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& mod
     if (!text) return Failure{exit_code::user_error, error};
     const auto j = nlohmann::json::parse(*text, nullptr, false);
     if (j.is_discarded() || !j.is_object() || j.value("format", "") != "sidc-fit" || !j.contains("groups") || !j["groups"].is_array())
-      return Failure{exit_code::user_error, fmt::format("error: `{}` is not a fit.json written by `sidc fit --out`\nhint: run `sidc fit MODEL --out DIR` and pass DIR/fit.json", a.params_file)};
+      return Failure{exit_code::user_error, render(cli_diag::not_a_fit_file(a.params_file))};
     for (const auto& g : j["groups"])
       for (const auto& p : g.value("parameters", nlohmann::json::array()))
         if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
@@ -105,7 +109,7 @@ std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& mod
     out.push_back(values[i].value_or(0.0));
   }
   if (!missing.empty())
-    return Failure{exit_code::usage_error, fmt::format("error: no value for {}\nhint: give every parameter a value with `--param NAME=VALUE`, or pass a fit's `--params fit.json`", missing)};
+    return Failure{exit_code::usage_error, render(cli_diag::missing_parameter_values(missing))};
   return out;
 }
 
@@ -121,11 +125,8 @@ std::variant<std::map<std::string, std::vector<std::optional<double>>>, Failure>
     while (!name.empty() && name.back() == '\'') name.pop_back(), ++order;
     const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&](const auto& o) { return o.name == name; });
     if (out == form.outputs.end())
-      return Failure{exit_code::usage_error, fmt::format("error: `--initial {}`: `{}` is not an output of the model\nhint: initial conditions are for outputs and their derivatives below the highest", text, name)};
-    if (order >= out->order)
-      return Failure{exit_code::usage_error,
-                     fmt::format("error: `--initial {}`: the state of `{}` is its derivatives of order 0 to {}; the equation gives order {}\nhint: drop this initial condition",
-                                 text, name, out->order - 1, out->order)};
+      return Failure{exit_code::usage_error, render(cli_diag::not_an_output(text, name))};
+    if (order >= out->order) return Failure{exit_code::usage_error, render(cli_diag::initial_order_too_high(text, name, out->order))};
     auto& values = initial[name];
     values.resize(static_cast<std::size_t>(out->order));
     values[static_cast<std::size_t>(order)] = v;
@@ -133,28 +134,15 @@ std::variant<std::map<std::string, std::vector<std::optional<double>>>, Failure>
   return initial;
 }
 
-std::string column_name(const ir::Model& model, const std::string& signal, const std::string& fallback) {
-  for (const auto& d : model.data)
-    for (const auto& [s, column] : d.bindings)
-      if (s == signal) return column;
-  return fallback;
-}
-
-std::string csv_field(const std::string& name) {
-  if (name.find_first_of(",\"\n") == std::string::npos) return name;
-  std::string out = "\"";
-  for (char c : name) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
 int run_simulate(const SimulateArguments& a) {
   auto fail = [](const std::string& message, int code) {
     std::cerr << message << "\n";
     return code;
   };
-  if (a.t0 && a.t1 && !(*a.t1 > *a.t0)) return fail(fmt::format("error: `--t1 {}` is not after `--t0 {}`", *a.t1, *a.t0), exit_code::usage_error);
-  std::string error;
-  auto compiled = load_compiled_model(a.model, error);
+  if (a.t0 && a.t1 && !(*a.t1 > *a.t0)) return fail(render(cli_diag::end_not_after_start(*a.t1, *a.t0)), exit_code::usage_error);
+  std::string error, warnings;
+  auto compiled = load_compiled_model(a.model, error, warnings);
+  std::cerr << warnings;
   if (!compiled) return fail(error, exit_code::user_error);
   const ir::Model& model = compiled->normalized;
   const auto& form = *compiled->explicit_form;
@@ -171,33 +159,34 @@ int run_simulate(const SimulateArguments& a) {
     o.method = SimulateOptions::Method::adaptive;
     o.stepper = a.stepper == "cash_karp" ? SimulateOptions::Stepper::cash_karp : SimulateOptions::Stepper::dopri5;
     if (a.tolerance) o.absolute_tolerance = o.relative_tolerance = *a.tolerance;
-    if (a.substeps) return fail("error: `--substeps` is for `--method rk4`\nhint: the adaptive method chooses its own steps; set `--tolerance`", exit_code::usage_error);
+    if (a.substeps)
+      return fail(render(cli_diag::option_for_other_method("--substeps", "rk4", "the adaptive method chooses its own steps; set `--tolerance`")), exit_code::usage_error);
   } else {
-    if (a.tolerance) return fail("error: `--tolerance` is for `--method adaptive`\nhint: the fixed-step method's accuracy is set by `--substeps`", exit_code::usage_error);
+    if (a.tolerance)
+      return fail(render(cli_diag::option_for_other_method("--tolerance", "adaptive", "the fixed-step method's accuracy is set by `--substeps`")), exit_code::usage_error);
     o.substeps = a.substeps.value_or(1);
   }
 
   // The record: --data, else the model's data statement; none is fine with a time grid.
   std::optional<SampledRecord> record;
-  std::string time_name = column_name(model, "t", "t");
+  std::string time_name = bound_column(model, "t", "t");
   ir::DataSource source = model.data.empty() ? ir::DataSource{} : model.data.front();
   if (!a.data.empty()) source.path = a.data;
   else if (!model.data.empty() && fs::path(source.path).is_relative())
     source.path = (fs::path(a.model).parent_path() / source.path).lexically_normal().string();
   if (!source.path.empty()) {
-    if (a.step) return fail("error: `--step` makes a time grid for a run without a record, but the simulation has one (`--data` or the model's data statement)\nhint: use `--every K` to thin the record", exit_code::usage_error);
+    if (a.step) return fail(render(cli_diag::step_with_record()), exit_code::usage_error);
     auto read = read_csv(source.path);
     if (auto* d = std::get_if<Diagnostic>(&read)) return fail(render(*d), exit_code::user_error);
-    BindOptions bind;
-    const EvaluationSettings e = evaluation_settings(model.settings);
-    bind.every = a.every.value_or(e.every);
-    bind.step = e.step;  // `set step` for a record without a time column
+    BindOptions bind = bind_options(evaluation_settings(model.settings));
+    bind.every = a.every.value_or(bind.every);
+    bind.weights.reset();  // a simulation weighs nothing: the record need not hold the weights column
     auto bound = bind_record(std::get<Record>(read), source, model, bind);
     if (auto* d = std::get_if<Diagnostic>(&bound)) return fail(render(*d), exit_code::user_error);
     record = std::get<SampledRecord>(std::move(bound));
     if (!std::get<Record>(read).column(time_name) && std::get<Record>(read).column("time")) time_name = "time";
   } else if (a.every) {
-    return fail("error: `--every` thins a record, but the simulation has none\nhint: give one with `--data record.csv`", exit_code::usage_error);
+    return fail(render(cli_diag::every_without_record()), exit_code::usage_error);
   }
 
   std::size_t first = 0;
@@ -209,9 +198,7 @@ int run_simulate(const SimulateArguments& a) {
     std::size_t last = first;
     while (last + 1 < time.size() && time[last + 1] <= to + tolerance) ++last;
     if (first >= time.size() || last <= first)
-      return fail(fmt::format("error: `{}` has fewer than two samples between t = {} and t = {}\nhint: the record runs from {} to {}", record->path, from, to,
-                              time.front(), time.back()),
-                  exit_code::user_error);
+      return fail(render(cli_diag::too_few_samples_between(record->path, from, to, time.front(), time.back())), exit_code::user_error);
     o.time.assign(time.begin() + static_cast<std::ptrdiff_t>(first), time.begin() + static_cast<std::ptrdiff_t>(last) + 1);
     for (const auto& s : model.signals)
       if (s.kind == ir::Signal::Kind::input && !s.definition)
@@ -219,27 +206,23 @@ int run_simulate(const SimulateArguments& a) {
           o.inputs[s.name].assign(it->second.begin() + static_cast<std::ptrdiff_t>(first), it->second.begin() + static_cast<std::ptrdiff_t>(last) + 1);
   } else {
     if (!a.t1 || !a.step)
-      return fail("error: without a record, the time grid needs `--t1` and `--step` (and `--t0`, default 0)\nhint: e.g. `--t1 1 --step 0.01`, or give a record with `--data`", exit_code::usage_error);
+      return fail(render(cli_diag::grid_needs_end_and_step()), exit_code::usage_error);
     const double t0 = a.t0.value_or(0.0);
-    if (!(*a.t1 > t0)) return fail(fmt::format("error: `--t1 {}` is not after t0 = {}", *a.t1, t0), exit_code::usage_error);
+    if (!(*a.t1 > t0)) return fail(render(cli_diag::end_not_after_t0(*a.t1, t0)), exit_code::usage_error);
     const auto count = static_cast<std::size_t>(std::floor((*a.t1 - t0) / *a.step + 1e-9));
-    if (count > 10'000'000) return fail(fmt::format("error: {} steps of {} from {} to {} is more than 10^7 output rows\nhint: use a larger `--step`", count, *a.step, t0, *a.t1), exit_code::usage_error);
+    if (count > 10'000'000) return fail(render(cli_diag::too_many_output_rows(count, *a.step, t0, *a.t1)), exit_code::usage_error);
     for (std::size_t i = 0; i <= count; ++i) o.time.push_back(t0 + static_cast<double>(i) * *a.step);
     for (const auto& s : model.signals)
       if (s.kind == ir::Signal::Kind::input && !s.definition)
-        return fail(fmt::format("error: input `{}` has no values: the simulation has no record and the model gives no definition\n"
-                                "hint: give a record with `--data record.csv`, or define it in the model (`input {} = sin(t)`)", s.name, s.name),
-                    exit_code::user_error);
+        return fail(render(cli_diag::input_without_values(s.name)), exit_code::user_error);
   }
   o.t0_for_tau = o.time.front();
 
   // Initial state: given, else from the record at the first simulated sample, else 0.
   std::map<std::string, std::vector<double>> from_record;
   if (record) {
-    EvaluationSettings e = evaluation_settings(model.settings);
-    DerivativeOptions d;
-    d.window = e.derivative.window;
-    d.polyorder = e.derivative.order;
+    // The model's derivative settings, all of them, as `sidc fit` reads them.
+    const DerivativeOptions d = evaluation_options(evaluation_settings(model.settings)).derivative;
     auto estimate = initial_state_from_record(explicit_, *record, d, first);
     if (auto* diag = std::get_if<Diagnostic>(&estimate)) return fail(render(*diag), exit_code::user_error);
     from_record = std::get<std::map<std::string, std::vector<double>>>(std::move(estimate));
@@ -254,20 +237,13 @@ int run_simulate(const SimulateArguments& a) {
       else values.push_back(0.0);
     }
   }
-  if (std::string why; !o.is_valid(&why)) return fail("error: " + why, exit_code::usage_error);
+  if (std::string why; !o.is_valid(&why)) return fail(render(cli_diag::invalid_options(why)), exit_code::usage_error);
 
   auto result = simulate(model, explicit_, o);
   if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
   const SimulationSummary& summary = std::get<SimulationSummary>(result);
 
-  std::string csv = csv_field(time_name);
-  for (const auto& name : summary.output_names) csv += "," + csv_field(column_name(model, name, name));
-  csv += "\n";
-  for (std::size_t i = 0; i < summary.time.size(); ++i) {
-    csv += fmt::format("{}", summary.time[i]);
-    for (const auto& v : summary.outputs) csv += fmt::format(",{}", v[i]);
-    csv += "\n";
-  }
+  const std::string csv = simulation_csv(model, time_name, summary);
   std::string initial_text;
   for (const auto& out : explicit_.outputs)
     for (int m = 0; m < out.order; ++m)
@@ -280,12 +256,11 @@ int run_simulate(const SimulateArguments& a) {
     std::cout << csv;
     std::cerr << report;
   } else {
-    if (!write_file_atomically(a.out, csv, &error)) return fail("error: " + error, exit_code::user_error);
+    if (!write_file_atomically(a.out, csv, &error)) return fail(render(cli_diag::cannot_write(error)), exit_code::user_error);
     std::cout << report << "wrote " << a.out << "\n";
   }
   if (!summary.completed()) {
-    std::cerr << "error: " << summary.message << "\nhint: check the parameter values and the initial state; the rows after the stop are NaN\n";
-    return exit_code::user_error;
+    return fail(render(cli_diag::simulation_stopped(summary.message)), exit_code::user_error);
   }
   return exit_code::success;
 }

@@ -1,6 +1,13 @@
 #include "diagnostics/source.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "diagnostics/cli_catalogue.hpp"
 
 namespace sidc {
 
@@ -25,6 +32,25 @@ std::string_view SourceFile::line_text(int line) const {
   if (end == std::string::npos) end = text.size();
   if (end > begin && text[end - 1] == '\r') --end;
   return std::string_view(text).substr(begin, end - begin);
+}
+
+std::variant<std::string, Diagnostic> read_text_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return cli_diag::is_directory(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return cli_diag::cannot_read(path, std::strerror(errno));
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  return std::move(contents).str();
+}
+
+std::optional<std::string> read_whole_file(const std::string& path, std::string& error) {
+  auto text = read_text_file(path);
+  if (auto* d = std::get_if<Diagnostic>(&text)) {
+    error = render(*d);
+    return std::nullopt;
+  }
+  return std::get<std::string>(std::move(text));
 }
 
 }  // namespace sidc

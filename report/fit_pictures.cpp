@@ -13,28 +13,13 @@
 #include "report/gnuplot_renderer.hpp"
 #include "report/html_report.hpp"
 #include "runtime/operators/plot_function.hpp"
+#include "runtime/solve/fitted_values.hpp"
 #include "runtime/records/records.hpp"
 
 namespace sidc {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::vector<std::string> input_names(const ir::Model& model) {
-  std::vector<std::string> names;
-  for (const auto& s : model.signals)
-    if (s.kind == ir::Signal::Kind::input) names.push_back(s.name);
-  return names;
-}
-
-// Fitted values by the model's parameter order (integration constants are no model parameters).
-std::vector<double> parameter_values(const ir::Model& model, const FitSummary& summary) {
-  std::vector<double> values(model.parameters.size(), std::numeric_limits<double>::quiet_NaN());
-  for (const auto& g : summary.groups)
-    for (const auto& p : g.summary.parameters)
-      if (const int i = model.parameter_index(p.name); i >= 0) values[static_cast<std::size_t>(i)] = p.value;
-  return values;
-}
 
 // The values of one signal derivative over the fit window of a record, as the fit estimated them.
 struct WindowValues {
@@ -145,7 +130,7 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
   for (const auto& record : c.records) per_record.push_back(std::make_unique<WindowEstimates>(record, model, c.options));
 
   // Figs. 4-1.13/4-1.14: each plotted function over the range its argument covers in the records.
-  const std::vector<double> values = parameter_values(normalized, c.summary);
+  const std::vector<double> values = fitted_parameter_values(normalized, c.summary, std::numeric_limits<double>::quiet_NaN());
   for (const auto& plot : normalized.plots) {
     double low = INFINITY, high = -INFINITY;
     for (auto& estimates : per_record)
@@ -256,63 +241,6 @@ ReportContent report_content(const PictureContext& c) {
 }
 
 }  // namespace
-
-ResidualAnalysis analyse_residuals(const ir::Model& model, const FitSummary& summary, const std::vector<SampledRecord>& records,
-                                   const FitOptions& options) {
-  ResidualAnalysis out;
-  const auto inputs = input_names(model);
-  for (std::size_t g = 0; g < summary.groups.size(); ++g) {
-    const GroupResiduals segments = group_residuals(model, records, options, summary, g, inputs, kMaxResidualRows);
-    out.truncated.push_back(segments.truncated);
-    if (!segments.ok) {
-      out.groups.emplace_back();
-      out.notes.push_back("not computed: " + segments.message);
-      continue;
-    }
-    out.groups.push_back(residual_correlation(segments.residuals, segments.inputs, {}));
-    out.notes.push_back(out.groups.back().is_usable() ? std::string() : "not computed: " + out.groups.back().message);
-  }
-  return out;
-}
-
-std::string residual_report(const ResidualAnalysis& analysis) {
-  std::string out;
-  for (std::size_t g = 0; g < analysis.groups.size(); ++g) {
-    const std::string group = analysis.groups.size() > 1 ? fmt::format(" (equation group {})", g + 1) : "";
-    if (!analysis.notes[g].empty()) {
-      out += fmt::format("\nresidual analysis{}: {}\n", group, analysis.notes[g]);
-      continue;
-    }
-    out += fmt::format("\n{}{}", group.empty() ? "" : fmt::format("equation group {}: ", g + 1), analysis.groups[g].brief_report());
-    if (g < analysis.truncated.size() && analysis.truncated[g])
-      out += fmt::format("{}  (the first {} rows only)\n", out.back() == '\n' ? "" : "\n", kMaxResidualRows);
-  }
-  if (!out.empty() && out.back() != '\n') out += "\n";
-  return out;
-}
-
-nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis) {
-  using nlohmann::ordered_json;
-  auto curve = [](const CorrelationCurve& c) {
-    return ordered_json{{"name", c.name}, {"computed", c.computed}, {"white", c.white}, {"verdict", c.verdict},
-                        {"lags", c.lags}, {"values", c.values}, {"lags_outside_band", c.lags_outside}};
-  };
-  ordered_json groups = ordered_json::array();
-  for (std::size_t g = 0; g < analysis.groups.size(); ++g) {
-    const auto& rc = analysis.groups[g];
-    if (!analysis.notes[g].empty()) {
-      groups.push_back({{"computed", false}, {"note", analysis.notes[g]}});
-      continue;
-    }
-    const bool truncated = g < analysis.truncated.size() && analysis.truncated[g];
-    ordered_json cross = ordered_json::array();
-    for (const auto& c : rc.cross) cross.push_back(curve(c));
-    groups.push_back({{"computed", true}, {"rows_used", truncated ? ordered_json(kMaxResidualRows) : ordered_json("all")}, {"n", rc.n}, {"segments", rc.segments}, {"max_lag", rc.max_lag},
-                      {"confidence_level", rc.confidence_level}, {"band", rc.band}, {"residuals_white", rc.residuals_white},
-                      {"verdict", rc.verdict}, {"autocorrelation", curve(rc.autocorrelation)}, {"cross_correlation", cross}});
-  }
-  return groups;
-}
 
 bool write_fit_pictures(const PictureContext& context, const PictureRequest& request, std::vector<std::string>& written,
                         std::string& error) {

@@ -1,6 +1,7 @@
 #include "runtime/simulate/validate.hpp"
 
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 
 namespace sidc {
@@ -109,6 +110,60 @@ std::string ValidationSummary::report(const std::string& method) const {
                        r.percent_error, r.fit_percent, r.rms_error);
   out += "  " + statement + "\n";
   return out;
+}
+
+FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
+                           const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const DerivativeOptions& derivative,
+                           std::size_t max_samples) {
+  FitValidation v;
+  v.max_samples = max_samples;
+  if (!summary.is_solution_usable()) {
+    v.note = "skipped: the fit is rank deficient, so its parameters are not worth simulating";
+    return v;
+  }
+  if (auto* d = std::get_if<Diagnostic>(&form)) {
+    v.note = "skipped: " + d->message;
+    return v;
+  }
+  const std::vector<double> parameters = fitted_parameter_values(normalized, summary, 0.0);
+  ValidationOptions o;
+  o.derivative = derivative;
+  o.max_samples = max_samples;
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    auto run = validate(normalized, std::get<ExplicitForm>(form), parameters, *records[r], o);
+    if (auto* d = std::get_if<Diagnostic>(&run)) {
+      if (r >= fitted_records) {  // a --validate record the user named: its problem is an error
+        v.failed_record = *d;
+        v.failed_path = records[r]->path;
+        return v;
+      }
+      v.note = fmt::format("skipped for `{}`: {}", records[r]->path, d->message);
+      continue;
+    }
+    v.runs.push_back(std::get<ValidationSummary>(std::move(run)));
+  }
+  return v;
+}
+
+std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<std::string>& subset,
+                                           const std::vector<double>& values, const std::vector<SampledRecord>& records,
+                                           const DerivativeOptions& derivative, std::size_t max_samples) {
+  std::vector<double> parameters(normalized.parameters.size(), 0.0);
+  for (std::size_t i = 0; i < subset.size(); ++i)
+    if (const int k = normalized.parameter_index(subset[i]); k >= 0) parameters[static_cast<std::size_t>(k)] = values[i];
+  ValidationOptions v;
+  v.derivative = derivative;
+  v.max_samples = max_samples;
+  double squares = 0;
+  std::size_t count = 0;
+  for (const auto& record : records) {
+    auto run = validate(normalized, form, parameters, record, v);
+    if (!std::holds_alternative<ValidationSummary>(run)) return std::nullopt;
+    const ValidationSummary& s = std::get<ValidationSummary>(run);
+    if (!s.simulation.completed()) return std::numeric_limits<double>::infinity();
+    for (const auto& out : s.outputs) squares += out.rms_error * out.rms_error * static_cast<double>(out.samples), count += out.samples;
+  }
+  return count ? std::sqrt(squares / static_cast<double>(count)) : std::optional<double>();
 }
 
 }  // namespace sidc

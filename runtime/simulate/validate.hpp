@@ -15,12 +15,14 @@
 // samples before the stop.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "ir/explicit_form.hpp"
 #include "runtime/operators/evaluate.hpp"
+#include "runtime/solve/fitted_values.hpp"
 #include "runtime/simulate/simulate.hpp"
 
 namespace sidc {
@@ -58,5 +60,32 @@ struct ValidationSummary {
 
 std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
                                                      const SampledRecord& record, const ValidationOptions& options);
+
+// The validation of one `sidc fit` (thesis section 2-4): the fitted equations solved and compared
+// with each record. Skipped, with one line saying why, when the equations cannot be solved for
+// their highest derivatives or the fit is not usable; never an error of the fit itself, except for
+// a record given only to be compared with (`failed_record`).
+struct FitValidation {
+  std::string note;  // why it was skipped; empty when it ran
+  std::vector<ValidationSummary> runs;
+  std::string method = "RK4, 4 steps per sample interval";
+  std::size_t max_samples = 0;         // per record, 0 = all
+  std::optional<Diagnostic> failed_record;  // a record past `fitted_records` that could not be compared
+  std::string failed_path;                  // and its path
+};
+
+// `records`: the fitted records first (`fitted_records` of them), then those given only to be
+// compared with. `form`: the compiled model's explicit form of `normalized`.
+FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
+                           const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const DerivativeOptions& derivative,
+                           std::size_t max_samples);
+
+// Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
+// with `values` for the parameters named in `subset` (the others 0) from each record, scored by the
+// RMS error over outputs and records; infinity when a run diverges, nullopt when a record cannot
+// be compared.
+std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<std::string>& subset,
+                                           const std::vector<double>& values, const std::vector<SampledRecord>& records,
+                                           const DerivativeOptions& derivative, std::size_t max_samples);
 
 }  // namespace sidc

@@ -1,0 +1,69 @@
+// Every message sidc prints about its command line and the files it is told to read or write, one
+// named constructor each, the command-line counterpart of model_catalogue.hpp and
+// data_catalogue.hpp. cli/ builds its errors only through these, so the wording lives here.
+// They carry no location: they are about options, not about text in a file. Codes are stable.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "diagnostics/diagnostic.hpp"
+
+namespace sidc::cli_diag {
+
+// ---- files named on the command line -----------------------------------------------------------
+Diagnostic is_directory(std::string_view path);
+Diagnostic cannot_read(std::string_view path, std::string_view reason);
+// `sidc compile` with a model file it cannot read.
+Diagnostic model_not_read(const Diagnostic& why);
+// `why` as given by report/atomic_file.hpp ("cannot write `FILE`: REASON").
+Diagnostic cannot_write(std::string_view why, std::string_view hint = {});
+Diagnostic cannot_create_directory(std::string_view path, std::string_view reason);
+Diagnostic no_compiled_model();
+Diagnostic fitting_most_recent(std::string_view path);
+Diagnostic compiled_model_not_json(std::string_view path);
+Diagnostic model_changed_since_compiled(std::string_view model, std::string_view compiled);
+Diagnostic not_a_fit_file(std::string_view path);
+
+// ---- options -----------------------------------------------------------------------------------
+// An option's own check failed; `why` says how (from an options struct's is_valid()).
+Diagnostic invalid_options(std::string_view why);
+Diagnostic not_a_moving_arc(std::string_view text);
+Diagnostic unknown_parameter(std::string_view option, std::string_view name, const std::vector<std::string>& names);
+// `sidc simulate --param NAME=...` for a name the model lacks; `names`: its parameters, listed.
+Diagnostic no_such_parameter(std::string_view name, std::string_view names);
+Diagnostic not_name_value(std::string_view option, std::string_view text, std::string_view example);
+Diagnostic value_not_finite(std::string_view option, std::string_view text, std::string_view value, std::string_view example);
+Diagnostic missing_parameter_values(std::string_view names);
+Diagnostic not_an_output(std::string_view text, std::string_view name);
+Diagnostic initial_order_too_high(std::string_view text, std::string_view name, int order);
+
+// ---- sidc fit ----------------------------------------------------------------------------------
+Diagnostic cannot_validate(std::string_view record, const Diagnostic& why);
+Diagnostic rank_deficient();
+Diagnostic pictures_of_several_models(std::size_t models);
+
+// ---- sidc select -------------------------------------------------------------------------------
+Diagnostic required_and_dropped(std::string_view name);
+Diagnostic bad_group(std::string_view spec);
+Diagnostic empty_group_member(std::string_view spec);
+Diagnostic in_two_groups(std::string_view name, std::string_view first, std::string_view second);
+Diagnostic simulate_needs_one_group();
+Diagnostic simulate_needs_explicit_form(const Diagnostic& why);
+Diagnostic selection_failed(std::string_view message);
+
+// ---- sidc simulate -----------------------------------------------------------------------------
+Diagnostic end_not_after_start(double t1, double t0);
+Diagnostic end_not_after_t0(double t1, double t0);
+Diagnostic option_for_other_method(std::string_view option, std::string_view method, std::string_view hint);
+Diagnostic step_with_record();
+Diagnostic every_without_record();
+Diagnostic too_few_samples_between(std::string_view record, double from, double to, double first, double last);
+Diagnostic grid_needs_end_and_step();
+Diagnostic too_many_output_rows(std::size_t count, double step, double t0, double t1);
+Diagnostic input_without_values(std::string_view input);
+Diagnostic simulation_stopped(std::string_view message);
+
+}  // namespace sidc::cli_diag

@@ -1,0 +1,219 @@
+#include "report/fit_files.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "diagnostics/cli_catalogue.hpp"
+#include "ir/print.hpp"
+#include "report/atomic_file.hpp"
+
+namespace sidc {
+namespace fs = std::filesystem;
+
+namespace {
+
+// residuals.csv, written as the rows come: a streamed fit evaluates them again block by block
+// (runtime/solve/fit.hpp, for_each_residual_block), so the file never has to be held in memory.
+bool write_residuals(std::ostream& out, const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
+                     const FitSummary& s, std::optional<Diagnostic>& problem) {
+  out << "group,equation,record,t,known,fitted,residual\n";
+  fmt::memory_buffer buffer;
+  for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
+    const auto d = for_each_residual_block(model, records, options, s, gi, [&](std::span<const ResidualRow> rows) {
+      buffer.clear();
+      for (const auto& r : rows)
+        fmt::format_to(std::back_inserter(buffer), "{},{},{},{},{},{},{}\n", gi + 1, r.equation + 1, records[r.record].path, r.time, r.known,
+                       r.known - r.residual, r.residual);
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      return static_cast<bool>(out);
+    });
+    if (d) problem = *d;
+    if (d || !out) return false;
+  }
+  return static_cast<bool>(out);
+}
+
+}  // namespace
+
+nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, const std::string& compiled_path, const FitOptions& o) {
+  using nlohmann::ordered_json;
+  const ir::Model& m = c.integrated;
+  ordered_json j;
+  j["format"] = "sidc-fit";
+  j["version"] = 1;
+  j["sidc_version"] = SIDC_VERSION;
+  j["model"] = m.name;
+  j["compiled_model"] = compiled_path;
+  j["source_hash"] = source_hash(c.source->text);
+  j["settings"] = {{"derivative", {{"window", o.evaluation.derivative.window}, {"order", o.evaluation.derivative.polyorder}}},
+                   {"second_derivative", o.evaluation.derivative.second == DerivativeOptions::Second::repeated ? "repeated" : "direct"},
+                   {"edges", o.evaluation.derivative.edges == DerivativeOptions::Edges::drop ? "drop" : "shorten"},
+                   {"integration", o.evaluation.integration.rule == IntegrationOptions::Rule::simpson ? "simpson" : "trapezoid"},
+                   {"from", o.from ? ordered_json(*o.from) : ordered_json(nullptr)},
+                   {"to", o.to ? ordered_json(*o.to) : ordered_json(nullptr)},
+                   {"precision", to_string(o.least_squares.precision)}};
+  ordered_json groups = ordered_json::array();
+  for (const auto& g : s.groups) {
+    const auto& ls = g.summary;
+    ordered_json equations = ordered_json::array();
+    for (std::size_t e : g.equations) equations.push_back({{"index", e + 1}, {"text", print(m.equations[e], m)}, {"integrations", m.equations[e].integrations}});
+    ordered_json records = ordered_json::array();
+    for (const auto& r : g.records) records.push_back({{"path", r.path}, {"t0", r.t0}, {"t_last", r.t_last}, {"step", r.step}, {"rows", r.rows}});
+    ordered_json parameters = ordered_json::array();
+    for (const auto& p : ls.parameters)
+      parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}}});
+    ordered_json regions = ordered_json::array();
+    for (const auto& r : g.regions) regions.push_back({{"guards", r.guards}, {"rows", r.rows}});
+    ordered_json dependent = ordered_json::array();
+    for (const auto& d : ls.dependent_groups) dependent.push_back(d);
+    groups.push_back({{"equations", equations}, {"records", records}, {"regions", regions}, {"parameters", parameters},
+                      {"statistics", {{"n", ls.n}, {"p", ls.p}, {"rank", ls.rank}, {"G", ls.G}, {"standard_error", ls.standard_error},
+                                      {"residual_sd", ls.residual_sd}, {"r_squared", ls.r_squared}, {"aic", ls.aic}, {"bic", ls.bic},
+                                      {"condition_before_scaling", ls.condition_before}, {"condition_after_scaling", ls.condition_after},
+                                      {"digits_lost_estimate", ls.digits_lost_estimate}}},
+                      {"termination", to_string(ls.termination)}, {"message", ls.message}, {"arithmetic", ls.arithmetic},
+                      {"dependent_operations", dependent}});
+  }
+  j["groups"] = std::move(groups);
+  return j;
+}
+
+nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis) {
+  using nlohmann::ordered_json;
+  auto curve = [](const CorrelationCurve& c) {
+    return ordered_json{{"name", c.name}, {"computed", c.computed}, {"white", c.white}, {"verdict", c.verdict},
+                        {"lags", c.lags}, {"values", c.values}, {"lags_outside_band", c.lags_outside}};
+  };
+  ordered_json groups = ordered_json::array();
+  for (std::size_t g = 0; g < analysis.groups.size(); ++g) {
+    const auto& rc = analysis.groups[g];
+    if (!analysis.notes[g].empty()) {
+      groups.push_back({{"computed", false}, {"note", analysis.notes[g]}});
+      continue;
+    }
+    const bool truncated = g < analysis.truncated.size() && analysis.truncated[g];
+    ordered_json cross = ordered_json::array();
+    for (const auto& c : rc.cross) cross.push_back(curve(c));
+    groups.push_back({{"computed", true}, {"rows_used", truncated ? ordered_json(kMaxResidualRows) : ordered_json("all")}, {"n", rc.n}, {"segments", rc.segments}, {"max_lag", rc.max_lag},
+                      {"confidence_level", rc.confidence_level}, {"band", rc.band}, {"residuals_white", rc.residuals_white},
+                      {"verdict", rc.verdict}, {"autocorrelation", curve(rc.autocorrelation)}, {"cross_correlation", cross}});
+  }
+  return groups;
+}
+
+nlohmann::ordered_json validation_json(const FitValidation& v) {
+  using nlohmann::ordered_json;
+  ordered_json j;
+  j["method"] = v.method;
+  j["note"] = v.note.empty() ? ordered_json(nullptr) : ordered_json(v.note);
+  ordered_json runs = ordered_json::array();
+  for (const auto& run : v.runs) {
+    ordered_json outputs = ordered_json::array();
+    for (const auto& r : run.outputs)
+      outputs.push_back({{"output", r.output}, {"samples", r.samples}, {"max_abs_error", r.max_abs_error}, {"time_of_max_abs_error", r.time_of_max},
+                         {"percent_error", r.percent_error}, {"fit_percent", r.fit_percent}, {"rms_error", r.rms_error}});
+    ordered_json initial = ordered_json::object();
+    for (const auto& [name, value] : run.initial_state) initial[name] = value;
+    runs.push_back({{"record", run.record}, {"completed", run.simulation.completed()},
+                    {"stopped_at", run.simulation.stopped_at ? ordered_json(*run.simulation.stopped_at) : ordered_json(nullptr)},
+                    {"statement", run.statement}, {"initial_state", initial}, {"steps", run.simulation.steps}, {"outputs", outputs}});
+  }
+  j["records"] = std::move(runs);
+  return j;
+}
+
+std::string validation_csv(const FitValidation& v) {
+  if (v.runs.empty()) return {};
+  std::string out = "record,t";
+  for (const auto& name : v.runs.front().simulation.output_names) out += fmt::format(",{0}_recorded,{0}_simulated,{0}_error", name);
+  out += "\n";
+  for (const auto& run : v.runs)
+    for (std::size_t i = 0; i < run.simulation.time.size(); ++i) {
+      out += fmt::format("{},{}", run.record, run.simulation.time[i]);
+      for (std::size_t j = 0; j < run.outputs.size(); ++j) out += fmt::format(",{},{},{}", run.recorded[j][i], run.simulated[j][i], run.error[j][i]);
+      out += "\n";
+    }
+  return out;
+}
+
+std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& f) {
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
+  const std::string json_path = (fs::path(directory) / "fit.json").string();
+  const std::string csv_path = (fs::path(directory) / "residuals.csv").string();
+  const std::string validation_path = (fs::path(directory) / "validation.csv").string();
+  auto json = fit_json(f.summary, f.compiled, f.compiled_path, f.options);
+  if (f.validation) json["validation"] = validation_json(*f.validation);
+  json["residual_analysis"] = residual_json(f.residuals);
+  const bool curves = f.validation && !f.validation->runs.empty();
+  std::string why;
+  std::optional<Diagnostic> problem;  // why the residual rows could not be had
+  const ir::Model& model = f.compiled.integrated;
+  if (!write_file_atomically(json_path, json.dump(1) + "\n", &why) ||
+      !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, f.records, f.options, f.summary, problem); }, &why) ||
+      (curves && !write_file_atomically(validation_path, validation_csv(*f.validation), &why))) {
+    // No half set of files: a fit.json without its residuals.csv would read as complete.
+    std::error_code ignored;
+    for (const auto& path : {json_path, csv_path, validation_path}) fs::remove(path, ignored);
+    return problem ? *problem : cli_diag::cannot_write(why);
+  }
+  std::vector<std::string> written{json_path, csv_path};
+  if (curves) written.push_back(validation_path);
+  return written;
+}
+
+nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& model_path, const SelectOptions& o) {
+  using nlohmann::ordered_json;
+  ordered_json j;
+  j["format"] = "sidc-select";
+  j["version"] = 1;
+  j["sidc_version"] = SIDC_VERSION;
+  j["model"] = s.model_name;
+  j["model_file"] = model_path;
+  j["settings"] = {{"method", to_string(o.method)}, {"folds", o.folds}, {"bootstrap", o.bootstrap}, {"seed", o.seed},
+                   {"max_size", o.max_size}, {"rule", to_string(o.rule)}, {"tolerance", o.tolerance},
+                   {"required", o.required}, {"dropped", o.dropped}};
+  ordered_json groups = ordered_json::array();
+  for (const auto& g : s.groups) {
+    ordered_json rows = ordered_json::array();
+    for (const auto& r : g.rows) {
+      ordered_json values = ordered_json::object();
+      for (std::size_t k = 0; k < r.parameters.size(); ++k) values[r.parameters[k]] = r.values[k];
+      rows.push_back({{"size", r.size}, {"parameters", values}, {"rank", r.rank}, {"G", r.G}, {"standard_error", r.standard_error},
+                      {"aic", r.aic}, {"bic", r.bic}, {"cv", std::isfinite(r.cv) ? ordered_json(r.cv) : ordered_json(nullptr)},
+                      {"cv_standard_error", std::isfinite(r.cv) ? ordered_json(r.cv_standard_error) : ordered_json(nullptr)},
+                      {"simulation", r.simulation ? ordered_json(*r.simulation) : ordered_json(nullptr)}});
+    }
+    auto size_at = [&](int index) { return index < 0 ? ordered_json(nullptr) : ordered_json(g.rows[static_cast<std::size_t>(index)].size); };
+    ordered_json operations = ordered_json::object();
+    for (std::size_t c = 0; c < g.columns.size(); ++c) operations[g.columns[c]] = g.operations[c];
+    ordered_json frequency = ordered_json::object();
+    for (std::size_t c = 0; c < g.bootstrap_frequency.size(); ++c) frequency[g.columns[c]] = g.bootstrap_frequency[c];
+    std::vector<std::size_t> equations;
+    for (std::size_t e : g.equations) equations.push_back(e + 1);
+    groups.push_back({{"equations", equations}, {"n", g.n}, {"operations", operations}, {"required", g.required}, {"dropped", g.dropped},
+                      {"method", to_string(g.method)}, {"subsets_evaluated", g.nodes}, {"subsets_total", g.subsets_total},
+                      {"search_seconds", g.search_seconds}, {"path", g.path}, {"sizes", rows},
+                      {"best_size", {{"aic", size_at(g.best_aic)}, {"bic", size_at(g.best_bic)}, {"cv", size_at(g.best_cv)}, {"least_cv", size_at(g.least_cv)},
+                                        {"simulation", size_at(g.best_simulation)}}},
+                      {"chosen_size", size_at(g.chosen)}, {"non_contributory", g.non_contributory},
+                      {"bootstrap", {{"replicates", g.bootstrap_replicates}, {"blocks", g.blocks}, {"frequency", frequency}}}});
+  }
+  j["groups"] = std::move(groups);
+  return j;
+}
+
+std::variant<std::string, Diagnostic> write_select_file(const std::string& directory, const SelectSummary& summary, const std::string& model_path,
+                                                        const SelectOptions& options) {
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
+  const std::string path = (fs::path(directory) / "select.json").string();
+  std::string why;
+  if (!write_file_atomically(path, select_json(summary, model_path, options).dump(1) + "\n", &why)) return cli_diag::cannot_write(why);
+  return path;
+}
+
+}  // namespace sidc

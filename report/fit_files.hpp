@@ -1,0 +1,49 @@
+// The files a fit and a selection write (`sidc fit --out DIR`, `sidc select --out DIR`): fit.json,
+// residuals.csv, validation.csv and select.json. Formats are documented in docs/cli.md.
+//
+// Relies on: report/atomic_file.hpp. Guarantees: each file appears whole or not at all, and a fit's
+// set appears whole or not at all: when one file cannot be written, those already written are
+// removed (a fit.json without its residuals.csv would read as complete). residuals.csv is written
+// as the rows come (a streamed fit evaluates them again block by block), never held in memory.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diagnostics/diagnostic.hpp"
+#include "ir/compiled_model.hpp"
+#include "runtime/select/select.hpp"
+#include "runtime/simulate/validate.hpp"
+#include "runtime/solve/fit.hpp"
+#include "runtime/solve/residual_analysis.hpp"
+
+namespace sidc {
+
+nlohmann::ordered_json fit_json(const FitSummary& summary, const CompiledModel& compiled, const std::string& compiled_path, const FitOptions& options);
+nlohmann::ordered_json validation_json(const FitValidation& validation);
+nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis);
+// record,t, then per output: recorded, simulated, error; "" when nothing was simulated.
+std::string validation_csv(const FitValidation& validation);
+
+struct FitFiles {
+  const CompiledModel& compiled;
+  std::string compiled_path;
+  const FitSummary& summary;
+  const FitOptions& options;
+  const std::vector<SampledRecord>& records;
+  const std::optional<FitValidation>& validation;  // nullopt: --no-validate
+  const ResidualAnalysis& residuals;
+};
+
+// Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating
+// DIR); the paths written, or the Diagnostic of the first failure (nothing of the set is left).
+std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& files);
+
+nlohmann::ordered_json select_json(const SelectSummary& summary, const std::string& model_path, const SelectOptions& options);
+// Writes DIR/select.json (creating DIR): its path, or the Diagnostic.
+std::variant<std::string, Diagnostic> write_select_file(const std::string& directory, const SelectSummary& summary, const std::string& model_path,
+                                                        const SelectOptions& options);
+
+}  // namespace sidc

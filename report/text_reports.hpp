@@ -1,0 +1,17 @@
+// What `sidc fit` prints beyond the fit's own report: the validation by simulation, the residual
+// analysis, and the comparison table of several models (thesis Table 4-1.2).
+#pragma once
+
+#include <string>
+
+#include "runtime/simulate/validate.hpp"
+#include "runtime/solve/model_comparison.hpp"
+#include "runtime/solve/residual_analysis.hpp"
+
+namespace sidc {
+
+std::string validation_report(const FitValidation& validation);
+std::string residual_report(const ResidualAnalysis& analysis);
+std::string comparison_table(const ModelComparison& comparison);
+
+}  // namespace sidc

@@ -1,0 +1,33 @@
+#include "runtime/solve/residual_analysis.hpp"
+
+namespace sidc {
+namespace {
+
+std::vector<std::string> input_names(const ir::Model& model) {
+  std::vector<std::string> names;
+  for (const auto& s : model.signals)
+    if (s.kind == ir::Signal::Kind::input) names.push_back(s.name);
+  return names;
+}
+
+}  // namespace
+
+ResidualAnalysis analyse_residuals(const ir::Model& model, const FitSummary& summary, const std::vector<SampledRecord>& records,
+                                   const FitOptions& options) {
+  ResidualAnalysis out;
+  const auto inputs = input_names(model);
+  for (std::size_t g = 0; g < summary.groups.size(); ++g) {
+    const GroupResiduals segments = group_residuals(model, records, options, summary, g, inputs, kMaxResidualRows);
+    out.truncated.push_back(segments.truncated);
+    if (!segments.ok) {
+      out.groups.emplace_back();
+      out.notes.push_back("not computed: " + segments.message);
+      continue;
+    }
+    out.groups.push_back(residual_correlation(segments.residuals, segments.inputs, {}));
+    out.notes.push_back(out.groups.back().is_usable() ? std::string() : "not computed: " + out.groups.back().message);
+  }
+  return out;
+}
+
+}  // namespace sidc

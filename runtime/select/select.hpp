@@ -73,7 +73,7 @@ struct SelectOptions {
   SizeRule rule = SizeRule::cv;       // which criterion names the non-contributory operations
   double tolerance = 1e-10;           // of the exact search, relative to G(0) (best_subset.hpp)
 
-  // Hook for ranking by free-run simulation error (issue 5's runtime/simulate): when set, called
+  // Hook for ranking by free-run simulation error (runtime/simulate/): when set, called
   // for the best subset of every size with the parameter names and values of that subset (all
   // others zero) and the group index; its value (smaller is better) is reported in a `sim` column
   // and can be the size rule later. sidc select --simulate sets it (cli/select_command.cpp).

@@ -1,4 +1,4 @@
-// compiler/explicit_form: equations solved for each output's highest derivative, structurally.
+// compiler/explicit_form_pass: equations solved for each output's highest derivative, structurally.
 // (The numerical check, that the explicit form agrees with the equation it came from, is in
 // tests/runtime/simulate_test.cpp, where the point evaluator lives.)
 #include "compiler/explicit_form_pass.hpp"

@@ -2,7 +2,7 @@
 // (the lead wires it in cli/). A correctly specified model leaves white residuals; a model with
 // a term missing leaves residuals that the whiteness test flags; both reach the report.
 //
-// Relies on: compiler/pipeline.hpp (model text -> ir::Model), runtime/fit, /usr/bin/gnuplot.
+// Relies on: compiler/pipeline.hpp (model text -> ir::Model), runtime/solve/fit, /usr/bin/gnuplot.
 #include <cmath>
 #include <filesystem>
 #include <fstream>

@@ -1,4 +1,4 @@
-// Unit tests of runtime/best_subset.*: the branch and bound against brute force over every subset.
+// Unit tests of runtime/select/best_subset.*: the branch and bound against brute force over every subset.
 //
 // The reference G of each subset is computed independently of the search: from the original rows
 // (not the triangle) by column-pivoted QR, in long double for the ill-conditioned designs. Designs:

@@ -1,4 +1,4 @@
-// Tests of runtime/fit: records, groups, weights and errors, on records where the model's
+// Tests of runtime/solve/fit: records, groups, weights and errors, on records where the model's
 // equation holds exactly (its input computed from analytic derivatives of the output).
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Unit tests of runtime/least_squares.* and runtime/triangular_accumulator.*.
+// Unit tests of runtime/solve/least_squares.* and runtime/solve/triangular_accumulator.*.
 //
 // Problems are constructed so that the answer is known independently of the solver: exact
 // solutions (integer data), residual vectors built orthogonal to the columns (so the parameters

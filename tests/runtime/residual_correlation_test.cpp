@@ -1,4 +1,4 @@
-// runtime/residual_correlation: white noise stays inside the 99% band at about the expected rate,
+// runtime/solve/residual_correlation: white noise stays inside the 99% band at about the expected rate,
 // AR(1) residuals and a delayed input effect are detected at the right lags, records are never
 // correlated across their join, and short, constant or non-finite input comes back as a status.
 //

@@ -1,4 +1,4 @@
-// runtime/point_evaluator, runtime/simulate, runtime/validate on problems with known solutions:
+// runtime/operators/point_evaluator, runtime/simulate/simulate, runtime/simulate/validate on problems with known solutions:
 // RK4's order of convergence measured, the adaptive tolerance honoured, a guard switch located,
 // divergence and a vanishing coefficient detected, a coupled multi-output system, validation.
 #include <cmath>

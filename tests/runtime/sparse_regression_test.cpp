@@ -1,4 +1,4 @@
-// Unit tests of runtime/sequential_threshold.* (STLSQ) and runtime/forward_regression.* (FROLS):
+// Unit tests of runtime/select/sequential_threshold.* (STLSQ) and runtime/select/forward_regression.* (FROLS):
 // both must recover a known sparse model from a synthetic design, honour required columns and
 // groups, and report a path that is consistent with independent least-squares fits.
 #include <algorithm>

@@ -2,8 +2,8 @@
 // conditions 4-1.3, solved by sidc's RK4 (examples/thesis-4-1/system_4_1_1.sid), against the
 // printed y of Appendix A, row by row.
 //
-// Relies on: the example model and appendix_a.csv (SIDC_SOURCE_DIR), compiler/explicit_form,
-// runtime/simulate. Guarantees: the check is the brief's, |y_sidc - y_printed| <= 0.005 (half a
+// Relies on: the example model and appendix_a.csv (SIDC_SOURCE_DIR), compiler/explicit_form_pass,
+// runtime/simulate/simulate. Guarantees: the check is the brief's, |y_sidc - y_printed| <= 0.005 (half a
 // unit of the printed second decimal), at every row but five, and those five are named here and
 // bounded by 0.006: the test fails if any other row leaves the half unit, or if one of the five
 // comes back inside it (then the finding below is out of date).

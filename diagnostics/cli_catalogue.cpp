@@ -29,8 +29,26 @@ Diagnostic model_not_read(const Diagnostic& why) {
 
 Diagnostic cannot_write(std::string_view why, std::string_view hint) { return message("cannot-write", std::string(why), std::string(hint)); }
 
-Diagnostic cannot_create_directory(std::string_view path, std::string_view reason) {
-  return message("cannot-create-directory", fmt::format("cannot create `{}`: {}", path, reason));
+Diagnostic cannot_create_directory(std::string_view path, std::string_view reason, std::string_view hint) {
+  return message("cannot-create-directory", fmt::format("cannot create `{}`: {}", path, reason), std::string(hint));
+}
+
+Diagnostic not_a_compiled_model(std::string_view path) { return message("not-a-compiled-model", fmt::format("`{}` is not a compiled sidc model", path)); }
+
+Diagnostic compiled_model_version(std::string_view path, int found, int expected) {
+  return message("compiled-model-version", fmt::format("`{}` was written in compiled-model format {}, this sidc reads format {}", path, found, expected));
+}
+
+Diagnostic invalid_compiled_model(std::string_view path, std::string_view what) {
+  return message("invalid-compiled-model", fmt::format("`{}` is not a valid compiled model ({}); compile the model again with `sidc compile`", path, what));
+}
+
+Diagnostic cannot_draw_figure(std::string_view figure, std::string_view why) {
+  return message("cannot-draw-figure", fmt::format("cannot draw figure `{}`: {}", figure, why));
+}
+
+Diagnostic cannot_read_back_figure(std::string_view figure, std::string_view why) {
+  return message("cannot-read-back-figure", fmt::format("cannot read back figure `{}`: {}", figure, why));
 }
 
 Diagnostic no_compiled_model() {

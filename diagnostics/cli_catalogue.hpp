@@ -20,7 +20,12 @@ Diagnostic cannot_read(std::string_view path, std::string_view reason);
 Diagnostic model_not_read(const Diagnostic& why);
 // `why` as given by report/atomic_file.hpp ("cannot write `FILE`: REASON").
 Diagnostic cannot_write(std::string_view why, std::string_view hint = {});
-Diagnostic cannot_create_directory(std::string_view path, std::string_view reason);
+Diagnostic cannot_create_directory(std::string_view path, std::string_view reason, std::string_view hint = {});
+Diagnostic not_a_compiled_model(std::string_view path);
+Diagnostic compiled_model_version(std::string_view path, int found, int expected);
+Diagnostic invalid_compiled_model(std::string_view path, std::string_view what);
+Diagnostic cannot_draw_figure(std::string_view figure, std::string_view why);
+Diagnostic cannot_read_back_figure(std::string_view figure, std::string_view why);
 Diagnostic no_compiled_model();
 Diagnostic fitting_most_recent(std::string_view path);
 Diagnostic compiled_model_not_json(std::string_view path);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <set>
 
+#include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
 #include "ir/settings.hpp"
 
@@ -285,12 +286,11 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
 std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_json& j, const std::string& path, std::string& error) {
   try {
     if (j.value("format", std::string()) != "sidc-compiled-model") {
-      error = fmt::format("error: `{}` is not a compiled sidc model", path);
+      error = render(cli_diag::not_a_compiled_model(path));
       return std::nullopt;
     }
     if (j.at("version").get<int>() != kCompiledModelVersion) {
-      error = fmt::format("error: `{}` was written in compiled-model format {}, this sidc reads format {}", path,
-                          j.at("version").get<int>(), kCompiledModelVersion);
+      error = render(cli_diag::compiled_model_version(path, j.at("version").get<int>(), kCompiledModelVersion));
       return std::nullopt;
     }
     CompiledModel c;
@@ -365,7 +365,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
     c.normalized = std::move(normalized);
     return c;
   } catch (const std::exception& ex) {
-    error = fmt::format("error: `{}` is not a valid compiled model ({}); compile the model again with `sidc compile`", path, ex.what());
+    error = render(cli_diag::invalid_compiled_model(path, ex.what()));
     return std::nullopt;
   }
 }

@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 
+#include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
@@ -255,7 +256,7 @@ bool write_fit_pictures(const PictureContext& context, const PictureRequest& req
   }
   fs::create_directories(directory, ec);
   if (ec) {
-    error = fmt::format("error: cannot create `{}`: {}\nhint: choose a folder you can write to", directory.string(), ec.message());
+    error = render(cli_diag::cannot_create_directory(directory.string(), ec.message(), "choose a folder you can write to"));
     return false;
   }
   ReportContent content = report_content(context);
@@ -264,7 +265,7 @@ bool write_fit_pictures(const PictureContext& context, const PictureRequest& req
   for (const auto& [figure, group] : fit_figures(context)) {
     const RenderSummary r = render_figure(figure, directory.string(), {});
     if (!r.ok()) {
-      error = fmt::format("error: cannot draw figure `{}`: {}", figure.name, r.message);
+      error = render(cli_diag::cannot_draw_figure(figure.name, r.message));
       ok = false;
       break;
     }
@@ -273,7 +274,7 @@ bool write_fit_pictures(const PictureContext& context, const PictureRequest& req
     std::string why;
     ReportFigure f = report_figure_from_file(r.files.front(), figure.title, &why);
     if (f.svg.empty()) {
-      error = fmt::format("error: cannot read back figure `{}`: {}", figure.name, why);
+      error = render(cli_diag::cannot_read_back_figure(figure.name, why));
       ok = false;
       break;
     }
@@ -283,7 +284,7 @@ bool write_fit_pictures(const PictureContext& context, const PictureRequest& req
   if (ok && !request.report_path.empty()) {
     const ReportWriteSummary w = write_html_report(content, request.report_path);
     if (!w.ok) {
-      error = fmt::format("error: cannot write `{}`: {}", request.report_path, w.message);
+      error = render(cli_diag::cannot_write(w.message));
       ok = false;
     } else {
       written.push_back(request.report_path);

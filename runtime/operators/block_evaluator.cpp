@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "runtime/operators/savitzky_golay.hpp"
 
@@ -18,24 +19,6 @@ using ir::FactorKind;
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-// Calls `visit` on every factor of `s` that is not local in time (integrals, initial values),
-// with the span of its term; descends into the arguments of the local ones.
-template <typename Visit>
-void for_each_whole_window_factor(const ir::Sum& s, Visit&& visit) {
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind == FactorKind::integral || f.kind == FactorKind::initial_value) {
-        visit(f, t.span);
-        continue;
-      }
-      if (f.argument) for_each_whole_window_factor(*f.argument, visit);
-      for (const auto& c : f.conditions) {
-        if (c.lhs) for_each_whole_window_factor(*c.lhs, visit);
-        if (c.rhs) for_each_whole_window_factor(*c.rhs, visit);
-      }
-    }
-}
-
 }  // namespace
 
 std::variant<WholeWindowValues, Diagnostic> prepare_whole_window_values(const SampledRecord& record, const ir::Model& model,
@@ -45,19 +28,22 @@ std::variant<WholeWindowValues, Diagnostic> prepare_whole_window_values(const Sa
   std::optional<Evaluator> evaluator;  // made only when needed: it caches whole-record vectors
   std::optional<Diagnostic> error;
   for (const ir::Sum* s : sums) {
-    for_each_whole_window_factor(*s, [&](const ir::Factor& f, const Span& where) {
-      if (error) return;
+    // The factors that are not local in time (integrals, initial values), with the span of their
+    // term; the local ones are looked into, and what an integral holds is evaluated with it.
+    ir::walk_factors(*s, [&](const ir::Factor& f, const ir::Term& t) {
+      if (f.kind != FactorKind::integral && f.kind != FactorKind::initial_value) return ir::Step::into;
       const std::string key = print(f);
-      if (whole.integrals.count(key) || whole.initial_values.count(key)) return;
+      if (whole.integrals.count(key) || whole.initial_values.count(key)) return ir::Step::over;
       if (!evaluator) evaluator.emplace(record, model, options, window);
-      auto values = evaluator->evaluate(ir::factor(f, 1, where));  // 0 + 1 * value: the value itself
+      auto values = evaluator->evaluate(ir::factor(f, 1, t.span));  // 0 + 1 * value: the value itself
       if (auto* d = std::get_if<Diagnostic>(&values)) {
         error = std::move(*d);
-        return;
+        return ir::Step::stop;
       }
       auto& v = std::get<std::vector<double>>(values);
       if (f.kind == FactorKind::initial_value) whole.initial_values[key] = v.empty() ? nan : v.front();
       else whole.integrals[key] = std::move(v);
+      return ir::Step::over;
     });
     if (error) return *error;
   }

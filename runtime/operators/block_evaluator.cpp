@@ -10,7 +10,7 @@
 #include "ir/print.hpp"
 #include "ir/traversal.hpp"
 #include "diagnostics/data_catalogue.hpp"
-#include "runtime/operators/savitzky_golay.hpp"
+#include "runtime/operators/signal_operator.hpp"
 
 namespace sidc {
 namespace {
@@ -63,13 +63,6 @@ const std::string& BlockEvaluator::name_of(const ir::Factor& f) {
   auto it = names_.find(&f);
   if (it == names_.end()) it = names_.emplace(&f, print(f)).first;
   return it->second;
-}
-
-std::size_t BlockEvaluator::margin(int order) const {
-  const auto h = static_cast<std::size_t>(options_.derivative.window / 2);
-  const bool repeated = options_.derivative.second == DerivativeOptions::Second::repeated && order >= 1;
-  // What `drop` loses (samples_lost_each_side), plus one window for `shorten`'s off-centre stencils.
-  return (repeated ? static_cast<std::size_t>(order) * h : h) + static_cast<std::size_t>(options_.derivative.window);
 }
 
 std::variant<std::monostate, Diagnostic> BlockEvaluator::evaluate(const ir::Sum& s, std::span<double> out,
@@ -164,7 +157,8 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
   const auto slice = [&](const std::vector<double>& whole, Range from) {
     return Values(whole.begin() + static_cast<std::ptrdiff_t>(from.first), whole.begin() + static_cast<std::ptrdiff_t>(from.last));
   };
-  // The range widened by `m` samples each side, within the record.
+  // The range widened by `m` samples each side, within the record: what a derivative operator
+  // reads to give the whole record's values on the range (the whole record when it has no reach).
   const auto widened = [&](std::size_t m) { return Range{r.first > m ? r.first - m : 0, std::min(samples, r.last + m)}; };
   // Values on [r.first, r.last) of an estimate made on `wide`.
   const auto middle = [&](const Values& estimate, Range wide) {
@@ -176,9 +170,10 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       const auto found = record_.signals.find(f.name);
       if (found == record_.signals.end()) return diag::signal_not_in_record(where, f.name, record_.path);
       if (f.order == 0) return slice(found->second, r);
-      const Range wide = widened(margin(f.order));
+      const auto op = derivative_operator(options_, f.order);
+      const Range wide = widened(op->reach().value_or(samples));
       const std::span<const double> samples_read(found->second.data() + wide.first, wide.size());
-      auto estimate = estimate_derivative(samples_read, record_.step, f.order, options_.derivative);
+      auto estimate = op->apply(samples_read, record_.step);
       if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
       return middle(std::get<Values>(estimate), wide);
     }
@@ -216,10 +211,11 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       return v;
     }
     case FactorKind::derivative: {
-      const Range wide = widened(margin(f.order));
+      const auto op = derivative_operator(options_, f.order);
+      const Range wide = widened(op->reach().value_or(samples));
       auto argument = sum(*f.argument, wide);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
-      auto estimate = estimate_derivative(std::get<Values>(argument), record_.step, f.order, options_.derivative);
+      auto estimate = op->apply(std::get<Values>(argument), record_.step);
       if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
       return middle(std::get<Values>(estimate), wide);
     }

@@ -56,6 +56,9 @@ std::optional<Sum> factor_at_window_start(const Factor& f) {
 bool has_value_at_window_start(const Sum& s) {
   return !ir::walk_factors(s, [](const Factor& f, const Term&) {
     if (f.kind == FactorKind::integral) return ir::Step::over;  // vanishes at t0 whatever it holds
+    // A function or power is judged by what it holds: asking factor_at_window_start for its
+    // value would write out its argument at t0, which throws when that has none.
+    if (f.kind == FactorKind::function || f.kind == FactorKind::power) return ir::Step::into;
     return factor_at_window_start(f) ? ir::Step::into : ir::Step::stop;
   });
 }

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <fmt/format.h>
-#include <functional>
 #include <map>
 
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
@@ -16,21 +16,6 @@ using ir::FactorKind;
 std::string derivative_text(const std::string& name, int order) { return name + std::string(static_cast<std::size_t>(order), '\''); }
 
 std::string term_text(const ir::Term& t) { return print(ir::canonical(std::vector<ir::Term>{t})); }
-
-// Visits every term of a sum and of every sum nested in its factors; `nested` is false only for
-// the terms of the top-level sum.
-void for_each_term(const ir::Sum& s, bool nested, const std::function<void(const ir::Term&, bool)>& visit) {
-  for (const auto& t : s.terms) {
-    visit(t, nested);
-    for (const auto& [f, power] : t.factors) {
-      if (f.argument) for_each_term(*f.argument, true, visit);
-      for (const auto& c : f.conditions) {
-        for_each_term(*c.lhs, true, visit);
-        for_each_term(*c.rhs, true, visit);
-      }
-    }
-  }
-}
 
 class Builder {
  public:
@@ -45,7 +30,7 @@ class Builder {
   std::variant<ExplicitForm, Diagnostic> build() {
     // 1. int() and der() anywhere; each output's order: its highest derivative anywhere.
     std::optional<Diagnostic> problem;
-    auto scan = [&](const ir::Term& t, bool) {
+    auto scan = [&](const ir::Term& t) {
       for (const auto& [f, power] : t.factors) {
         if (problem) return;
         if (f.kind == FactorKind::integral) problem = diag::simulate_integral(t.span, term_text(t));
@@ -61,8 +46,8 @@ class Builder {
       }
     };
     for (const auto& e : model_.equations) {
-      for (const auto& p : e.terms) for_each_term(p.operation, false, scan);
-      for_each_term(e.known, false, scan);
+      for (const auto& p : e.terms) ir::for_each_term(p.operation, scan);
+      ir::for_each_term(e.known, scan);
       if (problem) return *problem;
     }
     for (const auto& o : form_.outputs)
@@ -112,7 +97,7 @@ class Builder {
   // A highest derivative inside the sum (nested anywhere), for the nonlinear-entry messages.
   std::optional<std::string> highest_inside(const ir::Sum& s) const {
     std::optional<std::string> found;
-    for_each_term(s, true, [&](const ir::Term& t, bool) {
+    ir::for_each_term(s, [&](const ir::Term& t) {
       for (const auto& [f, power] : t.factors)
         if (!found && highest_of(f) >= 0) found = derivative_text(f.name, f.order);
     });
@@ -138,9 +123,9 @@ class Builder {
                         : f.kind == FactorKind::guard    ? "inside a guard"
                                                          : "inside another operation";
       std::optional<std::string> inner;
-      if (f.argument) inner = highest_inside(*f.argument);
-      for (const auto& c : f.conditions)
-        if (!inner) inner = highest_inside(*c.lhs), inner = inner ? inner : highest_inside(*c.rhs);
+      ir::for_each_nested_sum(f, [&](const ir::Sum& nested) {
+        if (!inner) inner = highest_inside(nested);
+      });
       if (inner) return diag::highest_derivative_nonlinear(t.span, *inner, fmt::format("{} in `{}`", where, term_text(t)));
     }
     ir::Term rest = t;

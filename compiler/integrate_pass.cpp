@@ -6,6 +6,7 @@
 
 #include "ir/differentiate.hpp"
 #include "ir/queries.hpp"
+#include "ir/traversal.hpp"
 #include "compiler/lower_pass.hpp"
 #include "ir/settings.hpp"
 #include "diagnostics/model_catalogue.hpp"
@@ -20,7 +21,7 @@ using ir::Term;
 
 Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
 
-// Anything that changes with time: a static equation (a plain regression) has none of these.
+// A guard among the term's own factors.
 bool has_guard(const Term& t) {
   return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return f.first.kind == FactorKind::guard; });
 }
@@ -36,11 +37,7 @@ std::optional<Sum> factor_at_window_start(const Factor& f) {
     case FactorKind::time: return ir::factor(make(FactorKind::window_start));
     case FactorKind::elapsed:
     case FactorKind::integral: return Sum{};  // both vanish at t0
-    case FactorKind::function: {
-      Factor g = f;
-      g.argument = ir::share(at_window_start(*f.argument));
-      return ir::factor(g);
-    }
+    case FactorKind::function:
     case FactorKind::power: {
       Factor g = f;
       g.argument = ir::share(at_window_start(*f.argument));
@@ -49,19 +46,21 @@ std::optional<Sum> factor_at_window_start(const Factor& f) {
     case FactorKind::parameter:
     case FactorKind::window_start:
     case FactorKind::initial_value: return ir::factor(f);
-    default: return std::nullopt;  // a derivative or guard factor: no value at t0 in the IR
+    case FactorKind::derivative:
+    case FactorKind::guard: return std::nullopt;  // no value at t0 in the IR
   }
+  return std::nullopt;
 }
 
 // True when F(t0) can be written with initial values (signals, time, functions of them).
 bool has_value_at_window_start(const Sum& s) {
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind == FactorKind::integral) continue;  // vanishes at t0 whatever it holds
-      if (!factor_at_window_start(f)) return false;
-      if ((f.kind == FactorKind::function || f.kind == FactorKind::power) && !has_value_at_window_start(*f.argument)) return false;
-    }
-  return true;
+  return !ir::walk_factors(s, [](const Factor& f, const Term&) {
+    if (f.kind == FactorKind::integral) return ir::Step::over;  // vanishes at t0 whatever it holds
+    // A function or power is judged by what it holds: asking factor_at_window_start for its
+    // value would write out its argument at t0, which throws when that has none.
+    if (f.kind == FactorKind::function || f.kind == FactorKind::power) return ir::Step::into;
+    return factor_at_window_start(f) ? ir::Step::into : ir::Step::stop;
+  });
 }
 Sum at_window_start(const Sum& s) {
   std::vector<Term> terms;

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "ir/differentiate.hpp"
+#include "ir/traversal.hpp"
 #include "compiler/parameter_split.hpp"
 #include "ir/print.hpp"
 #include "ir/settings.hpp"
@@ -514,34 +515,32 @@ struct Lowerer {
   }
 };
 
-// Every signal, time or estimated quantity in `s` other than the plot's argument, for its message.
+// The first signal, time or estimated quantity in `s` other than the plot's argument, with the
+// span of its term, for its message. Functions, powers and guards are judged by what they hold.
 std::optional<std::pair<std::string, Span>> foreign_quantity(const Sum& s, const std::string& signal, int order) {
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      switch (f.kind) {
-        case FactorKind::parameter: break;
-        case FactorKind::signal:
-          if (f.name != signal || f.order != order) return std::pair{f.name + std::string(static_cast<std::size_t>(f.order), '\''), t.span};
-          break;
-        case FactorKind::time: return std::pair{std::string("t"), t.span};
-        case FactorKind::elapsed: return std::pair{std::string("tau"), t.span};
-        case FactorKind::window_start: return std::pair{std::string("t0"), t.span};
-        case FactorKind::initial_value: return std::pair{f.name + "(t0)", t.span};
-        case FactorKind::integral: return std::pair{std::string("int(...)"), t.span};
-        case FactorKind::derivative: return std::pair{std::string("der(...)"), t.span};
-        case FactorKind::function:
-        case FactorKind::power:
-          if (auto inner = foreign_quantity(*f.argument, signal, order)) return inner;
-          break;
-        case FactorKind::guard:
-          for (const auto& c : f.conditions) {
-            if (auto inner = foreign_quantity(*c.lhs, signal, order)) return inner;
-            if (auto inner = foreign_quantity(*c.rhs, signal, order)) return inner;
-          }
-          break;
-      }
+  std::optional<std::pair<std::string, Span>> found;
+  ir::walk_factors(s, [&](const Factor& f, const Term& t) {
+    std::string name;
+    switch (f.kind) {
+      case FactorKind::parameter:
+      case FactorKind::function:
+      case FactorKind::power:
+      case FactorKind::guard: return ir::Step::into;
+      case FactorKind::signal:
+        if (f.name == signal && f.order == order) return ir::Step::into;
+        name = f.name + std::string(static_cast<std::size_t>(f.order), '\'');
+        break;
+      case FactorKind::time: name = "t"; break;
+      case FactorKind::elapsed: name = "tau"; break;
+      case FactorKind::window_start: name = "t0"; break;
+      case FactorKind::initial_value: name = f.name + "(t0)"; break;
+      case FactorKind::integral: name = "int(...)"; break;
+      case FactorKind::derivative: name = "der(...)"; break;
     }
-  return std::nullopt;
+    found = std::pair{std::move(name), t.span};
+    return ir::Step::stop;
+  });
+  return found;
 }
 
 // `plot name(y') = fitted against truth`: lowered with the equations' parameters only, split

@@ -6,6 +6,7 @@
 
 #include "compiler/parameter_split.hpp"
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "diagnostics/model_catalogue.hpp"
 
 namespace sidc {
@@ -21,25 +22,9 @@ bool has_parameters(const Sum& s) {
   });
 }
 
-bool uses_signal(const Sum& s);
-bool uses_signal(const ir::Factor& f) {
-  switch (f.kind) {
-    case FactorKind::signal:
-    case FactorKind::initial_value: return true;
-    case FactorKind::function:
-    case FactorKind::power:
-    case FactorKind::derivative:
-    case FactorKind::integral: return uses_signal(*f.argument);
-    case FactorKind::guard:
-      return std::any_of(f.conditions.begin(), f.conditions.end(),
-                         [](const ir::Condition& c) { return uses_signal(*c.lhs) || uses_signal(*c.rhs); });
-    default: return false;
-  }
-}
+// A signal or an initial value anywhere, inside functions, der(), int() and guards too.
 bool uses_signal(const Sum& s) {
-  return std::any_of(s.terms.begin(), s.terms.end(), [](const Term& t) {
-    return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return uses_signal(f.first); });
-  });
+  return ir::any_factor(s, [](const ir::Factor& f) { return f.kind == FactorKind::signal || f.kind == FactorKind::initial_value; });
 }
 
 // a = k*b for a number k: two parameters on such operations are as dependent as on equal ones.

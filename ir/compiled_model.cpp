@@ -70,7 +70,9 @@ ordered factor_json(const ir::Factor& f, int power) {
       j["conditions"] = std::move(conditions);
       break;
     }
-    default: break;
+    case FactorKind::time:
+    case FactorKind::elapsed:
+    case FactorKind::window_start: break;  // the kind says it all
   }
   j["power"] = power;
   return j;

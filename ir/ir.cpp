@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 
+#include "ir/traversal.hpp"
+
 namespace sidc::ir {
 namespace {
 
@@ -41,16 +43,13 @@ int compare_ptr(const SumPtr& a, const SumPtr& b) {
 }  // namespace
 
 bool Factor::is_constant_in_time() const {
-  switch (kind) {
-    case FactorKind::window_start:
-    case FactorKind::initial_value: return true;
-    case FactorKind::function:
-    case FactorKind::power:
-      return std::all_of(argument->terms.begin(), argument->terms.end(), [](const Term& t) {
-        return std::all_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return f.first.is_constant_in_time(); });
-      });
-    default: return false;
-  }
+  // t0 and initial values are constants; a function or power is one when nothing but those (and
+  // functions and powers of them) stands anywhere inside it.
+  const auto varies = [](const Factor& f) {
+    return f.kind != FactorKind::window_start && f.kind != FactorKind::initial_value && f.kind != FactorKind::function &&
+           f.kind != FactorKind::power;
+  };
+  return !varies(*this) && !(argument && any_factor(*argument, varies));
 }
 
 int compare(const Factor& a, const Factor& b) {
@@ -130,29 +129,16 @@ const char* to_string(Relation r) {
   return "<";
 }
 
-namespace {
-int highest_derivative_order(const Factor& f) {
-  switch (f.kind) {
-    case FactorKind::signal:
-    case FactorKind::initial_value: return f.order;
-    case FactorKind::derivative: return f.order + highest_derivative_order(*f.argument);
-    case FactorKind::function:
-    case FactorKind::power:
-    case FactorKind::integral: return highest_derivative_order(*f.argument);
-    case FactorKind::guard: {
-      int k = 0;
-      for (const auto& c : f.conditions) k = std::max({k, highest_derivative_order(*c.lhs), highest_derivative_order(*c.rhs)});
-      return k;
-    }
-    default: return 0;
-  }
-}
-}  // namespace
-
 int highest_derivative_order(const Sum& s) {
   int k = 0;
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) k = std::max(k, highest_derivative_order(f));
+  walk_factors(s, [&](const Factor& f, const Term&) {
+    if (f.kind == FactorKind::derivative) {  // der(y', 2) costs 3: the orders add up
+      k = std::max(k, f.order + highest_derivative_order(*f.argument));
+      return Step::over;
+    }
+    if (f.kind == FactorKind::signal || f.kind == FactorKind::initial_value) k = std::max(k, f.order);
+    return Step::into;
+  });
   return k;
 }
 

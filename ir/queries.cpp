@@ -20,8 +20,14 @@ bool is_dynamic(const ir::Sum& s) {
       case ir::FactorKind::elapsed:
       case ir::FactorKind::derivative:
       case ir::FactorKind::integral: return true;
-      default: return false;  // constants; functions, powers and guards are decided by what they hold
+      case ir::FactorKind::parameter:
+      case ir::FactorKind::window_start:
+      case ir::FactorKind::initial_value: return false;  // constants
+      case ir::FactorKind::function:
+      case ir::FactorKind::power:
+      case ir::FactorKind::guard: return false;  // decided by what they hold
     }
+    return false;
   });
 }
 

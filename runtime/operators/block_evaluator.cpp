@@ -8,8 +8,9 @@
 #include <stdexcept>
 
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "diagnostics/data_catalogue.hpp"
-#include "runtime/operators/savitzky_golay.hpp"
+#include "runtime/operators/signal_operator.hpp"
 
 namespace sidc {
 namespace {
@@ -17,24 +18,6 @@ namespace {
 using ir::FactorKind;
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
-// Calls `visit` on every factor of `s` that is not local in time (integrals, initial values),
-// with the span of its term; descends into the arguments of the local ones.
-template <typename Visit>
-void for_each_whole_window_factor(const ir::Sum& s, Visit&& visit) {
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind == FactorKind::integral || f.kind == FactorKind::initial_value) {
-        visit(f, t.span);
-        continue;
-      }
-      if (f.argument) for_each_whole_window_factor(*f.argument, visit);
-      for (const auto& c : f.conditions) {
-        if (c.lhs) for_each_whole_window_factor(*c.lhs, visit);
-        if (c.rhs) for_each_whole_window_factor(*c.rhs, visit);
-      }
-    }
-}
 
 }  // namespace
 
@@ -45,19 +28,22 @@ std::variant<WholeWindowValues, Diagnostic> prepare_whole_window_values(const Sa
   std::optional<Evaluator> evaluator;  // made only when needed: it caches whole-record vectors
   std::optional<Diagnostic> error;
   for (const ir::Sum* s : sums) {
-    for_each_whole_window_factor(*s, [&](const ir::Factor& f, const Span& where) {
-      if (error) return;
+    // The factors that are not local in time (integrals, initial values), with the span of their
+    // term; the local ones are looked into, and what an integral holds is evaluated with it.
+    ir::walk_factors(*s, [&](const ir::Factor& f, const ir::Term& t) {
+      if (f.kind != FactorKind::integral && f.kind != FactorKind::initial_value) return ir::Step::into;
       const std::string key = print(f);
-      if (whole.integrals.count(key) || whole.initial_values.count(key)) return;
+      if (whole.integrals.count(key) || whole.initial_values.count(key)) return ir::Step::over;
       if (!evaluator) evaluator.emplace(record, model, options, window);
-      auto values = evaluator->evaluate(ir::factor(f, 1, where));  // 0 + 1 * value: the value itself
+      auto values = evaluator->evaluate(ir::factor(f, 1, t.span));  // 0 + 1 * value: the value itself
       if (auto* d = std::get_if<Diagnostic>(&values)) {
         error = std::move(*d);
-        return;
+        return ir::Step::stop;
       }
       auto& v = std::get<std::vector<double>>(values);
       if (f.kind == FactorKind::initial_value) whole.initial_values[key] = v.empty() ? nan : v.front();
       else whole.integrals[key] = std::move(v);
+      return ir::Step::over;
     });
     if (error) return *error;
   }
@@ -77,13 +63,6 @@ const std::string& BlockEvaluator::name_of(const ir::Factor& f) {
   auto it = names_.find(&f);
   if (it == names_.end()) it = names_.emplace(&f, print(f)).first;
   return it->second;
-}
-
-std::size_t BlockEvaluator::margin(int order) const {
-  const auto h = static_cast<std::size_t>(options_.derivative.window / 2);
-  const bool repeated = options_.derivative.second == DerivativeOptions::Second::repeated && order >= 1;
-  // What `drop` loses (samples_lost_each_side), plus one window for `shorten`'s off-centre stencils.
-  return (repeated ? static_cast<std::size_t>(order) * h : h) + static_cast<std::size_t>(options_.derivative.window);
 }
 
 std::variant<std::monostate, Diagnostic> BlockEvaluator::evaluate(const ir::Sum& s, std::span<double> out,
@@ -178,7 +157,8 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
   const auto slice = [&](const std::vector<double>& whole, Range from) {
     return Values(whole.begin() + static_cast<std::ptrdiff_t>(from.first), whole.begin() + static_cast<std::ptrdiff_t>(from.last));
   };
-  // The range widened by `m` samples each side, within the record.
+  // The range widened by `m` samples each side, within the record: what a derivative operator
+  // reads to give the whole record's values on the range (the whole record when it has no reach).
   const auto widened = [&](std::size_t m) { return Range{r.first > m ? r.first - m : 0, std::min(samples, r.last + m)}; };
   // Values on [r.first, r.last) of an estimate made on `wide`.
   const auto middle = [&](const Values& estimate, Range wide) {
@@ -190,9 +170,10 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       const auto found = record_.signals.find(f.name);
       if (found == record_.signals.end()) return diag::signal_not_in_record(where, f.name, record_.path);
       if (f.order == 0) return slice(found->second, r);
-      const Range wide = widened(margin(f.order));
+      const auto op = derivative_operator(options_, f.order);
+      const Range wide = widened(op->reach().value_or(samples));
       const std::span<const double> samples_read(found->second.data() + wide.first, wide.size());
-      auto estimate = estimate_derivative(samples_read, record_.step, f.order, options_.derivative);
+      auto estimate = op->apply(samples_read, record_.step);
       if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
       return middle(std::get<Values>(estimate), wide);
     }
@@ -230,10 +211,11 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       return v;
     }
     case FactorKind::derivative: {
-      const Range wide = widened(margin(f.order));
+      const auto op = derivative_operator(options_, f.order);
+      const Range wide = widened(op->reach().value_or(samples));
       auto argument = sum(*f.argument, wide);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
-      auto estimate = estimate_derivative(std::get<Values>(argument), record_.step, f.order, options_.derivative);
+      auto estimate = op->apply(std::get<Values>(argument), record_.step);
       if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
       return middle(std::get<Values>(estimate), wide);
     }

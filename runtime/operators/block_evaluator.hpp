@@ -2,12 +2,13 @@
 // of 10^7 rows never holds a whole-record vector per operation (runtime/solve/fit.cpp's streamed path).
 //
 // Relies on: evaluate.hpp (SampledRecord, FitWindow, Evaluator for the values that are not local
-// in time), savitzky_golay.hpp (estimate_derivative). Guarantees:
-// - Local operations (signals, their moving-arc derivatives, der() of sums, time, tau, t0,
-//   products, integer powers, functions, guards) are computed on the block plus a margin of
-//   samples on each side: a k-th derivative reads k * (window - 1) / 2 samples beyond the block
-//   (eqs. 3-1.2 to 3-1.8; one extra window more, so that `shorten` edges, which move the stencil
-//   off centre near the end of whatever it is given, only touch the margin). Values are therefore
+// in time), signal_operator.hpp (derivative_operator() and its reach()). Guarantees:
+// - Local operations (signals, their derivatives, der() of sums, time, tau, t0, products, integer
+//   powers, functions, guards) are computed on the block plus a margin of samples on each side:
+//   a derivative reads its operator's reach() beyond the block (for the k-th moving-arc derivative
+//   k * (window - 1) / 2 samples, eqs. 3-1.2 to 3-1.8, and one extra window so that `shorten`
+//   edges, which move the stencil off centre near the end of whatever it is given, only touch the
+//   margin; an operator without a reach reads the whole record). Values are therefore
 //   identical, bit for bit, to Evaluator's on the whole record, except integer powers y^k with
 //   k >= 3, which are repeated products here (y^3 = y^2 * y) where Evaluator calls std::pow:
 //   they agree to a few units in the last place.
@@ -77,7 +78,6 @@ class BlockEvaluator {
   std::variant<const Values*, Diagnostic> power_of(const ir::Factor& f, int power, const Span& where, Range r);
   std::variant<Values, Diagnostic> compute_factor(const ir::Factor& f, const Span& where, Range r);
   const std::string& name_of(const ir::Factor& f);
-  std::size_t margin(int order) const;  // samples beyond a range a derivative of this order reads
 
   const SampledRecord& record_;
   EvaluationOptions options_;

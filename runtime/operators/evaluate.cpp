@@ -65,7 +65,7 @@ std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, cons
                                                std::optional<double> to) {
   const std::size_t n = record.time.size();
   const int order = highest_derivative_order(model);
-  const std::size_t margin = order > 0 ? static_cast<std::size_t>(samples_lost_each_side(order, options.derivative)) : 0;
+  const std::size_t margin = order > 0 ? static_cast<std::size_t>(derivative_operator(options, order)->samples_lost_each_side()) : 0;
   FitWindow w;
   w.first = margin;
   w.last = n > margin ? n - 1 - margin : 0;
@@ -93,7 +93,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::strin
     return diag::signal_not_in_record(where, name, record_.path);
   }
   if (order == 0) return derivatives_[key] = found->second;
-  auto estimate = estimate_derivative(found->second, record_.step, order, options_.derivative);
+  auto estimate = derivative_operator(options_, order)->apply(found->second, record_.step);
   if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
   return derivatives_[key] = std::get<Values>(std::move(estimate));
 }
@@ -168,13 +168,13 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
       const Values& a = std::get<Values>(argument);
       Values v(n, nan);
       if (f.kind == FactorKind::derivative) {
-        auto estimate = estimate_derivative(a, record_.step, f.order, options_.derivative);
+        auto estimate = derivative_operator(options_, f.order)->apply(a, record_.step);
         if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
         v = std::get<Values>(std::move(estimate));
       } else {
-        // eq. 2-1.4: from t0 (the window's first sample) to t; Simpson's rule (section 3-2).
+        // eq. 2-1.4: from t0 (the window's first sample) to t; Simpson's rule by default (section 3-2).
         const std::span<const double> slice(a.data() + window_.first, window_.size());
-        auto integral = cumulative_integral(slice, record_.step, options_.integration);
+        auto integral = integral_operator(options_)->apply(slice, record_.step);
         if (auto* d = std::get_if<Diagnostic>(&integral)) return *d;
         const Values& c = std::get<Values>(integral);
         std::copy(c.begin(), c.end(), v.begin() + static_cast<std::ptrdiff_t>(window_.first));

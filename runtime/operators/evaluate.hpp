@@ -1,10 +1,11 @@
 // Evaluation of compiled operations on a sampled record, column by column (thesis chapter III).
 //
 // Relies on: a compiled model (ir/ir.hpp) and a record bound to its signals on a uniform
-// time grid. Guarantees: every factor is evaluated over the whole record — derivatives by the
-// moving-arc operator (eqs. 3-1.2 to 3-1.8), integrals by cumulative Simpson (or trapezoid) from
-// the window start t0 (eqs. 2-1.4, 2-2.5), products, powers, functions and guards sample by sample —
-// with NaN where a value does not exist (the edges a derivative loses, before t0 for an integral).
+// time grid. Guarantees: every factor is evaluated over the whole record — derivatives and
+// integrals by the SignalOperator the options choose (signal_operator.hpp: the moving arc, eqs.
+// 3-1.2 to 3-1.8; cumulative Simpson or trapezoid from the window start t0, eqs. 2-1.4, 2-2.5),
+// products, powers, functions and guards sample by sample — with NaN where a value does not exist
+// (the edges a derivative loses, before t0 for an integral).
 // Each derivative and integral is computed once per record and reused. A value that is NaN or
 // infinite inside the fit window is reported with the source span of the operation that made it.
 #pragma once
@@ -19,6 +20,7 @@
 #include "ir/ir.hpp"
 #include "diagnostics/diagnostic.hpp"
 #include "runtime/operators/savitzky_golay.hpp"
+#include "runtime/operators/signal_operator.hpp"
 #include "runtime/operators/simpson.hpp"
 
 namespace sidc {
@@ -34,6 +36,7 @@ struct SampledRecord {
   std::string weights_column;
 };
 
+// What chooses and configures the operators (derivative_operator(), integral_operator()).
 struct EvaluationOptions {
   DerivativeOptions derivative;
   IntegrationOptions integration;

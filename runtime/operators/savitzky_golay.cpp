@@ -220,4 +220,24 @@ std::variant<std::vector<double>, Diagnostic> estimate_derivative(std::span<cons
   return current;
 }
 
+std::string MovingArcOperator::name() const {
+  const bool several = order_ >= 2;
+  return fmt::format("{}-point moving arc of order {}, {}{}{}", options_.window, options_.polyorder,
+                     order_ == 0 ? std::string("smoothing") : fmt::format("derivative {}", order_),
+                     several ? (options_.second == DerivativeOptions::Second::repeated ? " (repeated)" : " (direct)") : "",
+                     options_.edges == DerivativeOptions::Edges::shorten ? ", edges shortened" : "");
+}
+
+int MovingArcOperator::samples_lost_each_side() const { return sidc::samples_lost_each_side(order_, options_); }
+
+std::optional<std::size_t> MovingArcOperator::reach() const {
+  const auto h = static_cast<std::size_t>(options_.window / 2);
+  const bool repeated = options_.second == DerivativeOptions::Second::repeated && order_ >= 1;
+  return (repeated ? static_cast<std::size_t>(order_) * h : h) + static_cast<std::size_t>(options_.window);
+}
+
+std::variant<std::vector<double>, Diagnostic> MovingArcOperator::apply(std::span<const double> samples, double step) const {
+  return estimate_derivative(samples, step, order_, options_);
+}
+
 }  // namespace sidc

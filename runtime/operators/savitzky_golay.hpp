@@ -2,7 +2,8 @@
 // thesis section 3-1: fit a low-order polynomial by least squares to the samples around t_n and
 // take the polynomial's value or derivative at t_n.
 //
-// Relies on: nothing but <cmath> (a Gram-Schmidt QR in long double). Guarantees: weights are derived in code
+// Relies on: <cmath> alone for the numerics (a Gram-Schmidt QR in long double); signal_operator.hpp
+// for the interface MovingArcOperator presents to the evaluators. Guarantees: weights are derived in code
 // for any odd window, any polynomial order < window, any derivative order <= polynomial order,
 // any evaluation position inside the window (off-centre weights serve the edges), and any
 // spacing delta, agreeing with the exact rational weights to about 1e-15 relative (tested against
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "diagnostics/diagnostic.hpp"
+#include "runtime/operators/signal_operator.hpp"
 
 namespace sidc {
 
@@ -90,5 +92,21 @@ int samples_lost_each_side(int order, const DerivativeOptions& options);
 // not positive, order > polyorder under `direct`, fewer samples than the window under `shorten`.
 std::variant<std::vector<double>, Diagnostic> estimate_derivative(std::span<const double> samples, double delta,
                                                                   int order, const DerivativeOptions& options);
+
+// estimate_derivative() of one order as a SignalOperator, what the evaluators call.
+class MovingArcOperator final : public SignalOperator {
+ public:
+  MovingArcOperator(int order, const DerivativeOptions& options) : order_(order), options_(options) {}
+  std::string name() const override;
+  int samples_lost_each_side() const override;
+  // What `drop` loses, plus one window: `shorten` moves the stencils off centre near the ends of
+  // whatever it is given, and that must only touch the margin.
+  std::optional<std::size_t> reach() const override;
+  std::variant<std::vector<double>, Diagnostic> apply(std::span<const double> samples, double step) const override;
+
+ private:
+  int order_;
+  DerivativeOptions options_;
+};
 
 }  // namespace sidc

@@ -1,6 +1,7 @@
 #include "runtime/operators/simpson.hpp"
 
 #include <cmath>
+#include <fmt/format.h>
 
 #include "diagnostics/data_catalogue.hpp"
 
@@ -59,6 +60,17 @@ std::variant<std::vector<double>, Diagnostic> cumulative_integral(std::span<cons
   }
   return options.rule == IntegrationOptions::Rule::simpson ? cumulative_simpson(integrand, delta)
                                                            : cumulative_trapezoid(integrand, delta);
+}
+
+std::string CumulativeIntegralOperator::name() const {
+  std::string rule = options_.rule == IntegrationOptions::Rule::simpson ? "Simpson's rule" : "trapezoid rule";
+  if (options_.smoothing_window > 0)
+    rule += fmt::format(" after a {}-point moving arc of order {}", options_.smoothing_window, options_.smoothing_polyorder);
+  return rule;
+}
+
+std::variant<std::vector<double>, Diagnostic> CumulativeIntegralOperator::apply(std::span<const double> samples, double step) const {
+  return cumulative_integral(samples, step, options_);
 }
 
 }  // namespace sidc

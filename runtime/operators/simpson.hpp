@@ -3,7 +3,8 @@
 // three points"), optionally after moving-arc smoothing ("it is advisable to first smooth the
 // data before actually performing the integration").
 //
-// Relies on: savitzky_golay.hpp for the optional smoothing. Guarantees: I[0] = 0 and I[i] is the
+// Relies on: savitzky_golay.hpp for the optional smoothing, signal_operator.hpp for the interface
+// CumulativeIntegralOperator presents to the evaluators. Guarantees: I[0] = 0 and I[i] is the
 // integral from sample 0 to sample i, at every i; nested integrals are repeated application.
 //
 // cumulative_simpson, exactly:
@@ -24,6 +25,7 @@
 
 #include "diagnostics/diagnostic.hpp"
 #include "runtime/operators/savitzky_golay.hpp"
+#include "runtime/operators/signal_operator.hpp"
 
 namespace sidc {
 
@@ -46,5 +48,19 @@ struct IntegrationOptions {
 // fewer samples than the smoothing window.
 std::variant<std::vector<double>, Diagnostic> cumulative_integral(std::span<const double> values, double delta,
                                                                   const IntegrationOptions& options = {});
+
+// cumulative_integral() as a SignalOperator, what the evaluators call. Every sample has a value,
+// and every value depends on all the samples before it (reach() is nullopt).
+class CumulativeIntegralOperator final : public SignalOperator {
+ public:
+  explicit CumulativeIntegralOperator(const IntegrationOptions& options) : options_(options) {}
+  std::string name() const override;
+  int samples_lost_each_side() const override { return 0; }
+  std::optional<std::size_t> reach() const override { return std::nullopt; }
+  std::variant<std::vector<double>, Diagnostic> apply(std::span<const double> samples, double step) const override;
+
+ private:
+  IntegrationOptions options_;
+};
 
 }  // namespace sidc

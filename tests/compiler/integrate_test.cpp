@@ -41,6 +41,13 @@ TEST(Antiderivative, InitialValuesSubtracted) {
   EXPECT_EQ(integrated_known("t", true), "t^2/2 - t0^2/2");
 }
 
+TEST(Antiderivative, NoValueAtT0InsideAFunctionMeansNumericalIntegral) {
+  // int(der(u, 1)) = u, but with `constants = initial` u(t0) must be written out, and a guard
+  // inside sin() has no value at t0: the term stays a numerical integral (it once was an internal error).
+  EXPECT_EQ(integrated_known("der(sin([y > 0]*y), 1)", true), "int(der(sin(y*[y > 0]), 1))");
+  EXPECT_EQ(integrated_known("der(sin([y > 0]*y), 1)", false), "sin(y*[y > 0])");
+}
+
 TEST(Antiderivative, EveryExactPieceDifferentiatesBack) {
   // Property: for sums whose terms have exact antiderivatives, d/dt of the result gives them back.
   for (const char* e : {"y''", "y^2*y'", "y'*y''", "x'*y + x*y'", "7*y^6*y' + y'''", "t*y' + y"}) {

@@ -485,5 +485,35 @@ TEST(DerivativeEstimate, ThesisAppendixARecord) {
   RecordProperty("max_percent_error_second", std::to_string(100 * max_second / 492));
 }
 
+// The contract block evaluation relies on (signal_operator.hpp): given reach() samples beyond a
+// block on each side, the operator's values on the block are bit for bit its values on the whole
+// record, under every edge rule and way of taking higher derivatives.
+TEST(MovingArcOperator, ReachGivesTheWholeRecordsValuesOnABlock) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0, 0.01);
+  std::vector<double> y(200);
+  for (std::size_t i = 0; i < y.size(); ++i) y[i] = std::sin(0.05 * static_cast<double>(i)) + noise(rng);
+  const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+  for (const auto edges : {DerivativeOptions::Edges::drop, DerivativeOptions::Edges::shorten})
+    for (const auto second : {DerivativeOptions::Second::repeated, DerivativeOptions::Second::direct})
+      for (int order = 0; order <= 3; ++order) {
+        DerivativeOptions o;
+        o.edges = edges;
+        o.second = second;
+        const MovingArcOperator op(order, o);
+        EXPECT_EQ(op.samples_lost_each_side(), samples_lost_each_side(order, o));
+        const auto whole = std::get<std::vector<double>>(op.apply(y, 0.1));
+        const auto direct = derivative_of(y, 0.1, order, o);
+        for (std::size_t i = 0; i < y.size(); ++i) EXPECT_TRUE(same(whole[i], direct[i])) << op.name() << ", sample " << i;
+        const std::size_t reach = *op.reach();
+        for (const std::size_t first : {std::size_t{0}, std::size_t{5}, std::size_t{40}, std::size_t{150}}) {
+          const std::size_t last = std::min(y.size(), first + 30);
+          const std::size_t from = first > reach ? first - reach : 0, to = std::min(y.size(), last + reach);
+          const auto part = std::get<std::vector<double>>(op.apply(std::span(y).subspan(from, to - from), 0.1));
+          for (std::size_t i = first; i < last; ++i) EXPECT_TRUE(same(whole[i], part[i - from])) << op.name() << ", sample " << i;
+        }
+      }
+}
+
 }  // namespace
 }  // namespace sidc

@@ -1,34 +1,16 @@
 // sidc as a library: a model file compiled, fitted to a record, and its estimates printed, as
 // `sidc fit MODEL.sid --data RECORD.csv` does without its reports and validation. The record's
 // columns are bound to the signals as the model's data statement says, and the model's settings
-// (`set derivative = ...`, `set to = ...`) are the fit's options, as cli/record_options.cpp does.
+// (`set derivative = ...`, `set to = ...`) become the fit's options through the same translation
+// the sidc command uses (runtime/solve/options_from_settings.hpp).
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "compiler/pipeline.hpp"
-#include "ir/settings.hpp"
 #include "runtime/records/bind_record.hpp"
-#include "runtime/solve/fit.hpp"
+#include "runtime/solve/options_from_settings.hpp"
 
 using namespace sidc;
-
-FitOptions fit_options(const EvaluationSettings& s) {
-  FitOptions o;  // documented defaults (runtime/solve/fit.hpp), then the model's settings
-  o.evaluation.derivative.window = s.derivative.window;
-  o.evaluation.derivative.polyorder = s.derivative.order;
-  if (!s.second_derivative_repeated) o.evaluation.derivative.second = DerivativeOptions::Second::direct;
-  if (s.shorten_edges) o.evaluation.derivative.edges = DerivativeOptions::Edges::shorten;
-  if (s.trapezoid) o.evaluation.integration.rule = IntegrationOptions::Rule::trapezoid;
-  if (s.smooth_before_integration) {
-    o.evaluation.integration.smoothing_window = s.smooth_before_integration->window;
-    o.evaluation.integration.smoothing_polyorder = s.smooth_before_integration->order;
-  }
-  o.from = s.from;
-  o.to = s.to;
-  return o;
-}
 
 int fail(const std::string& message) {
   std::cerr << message << "\n";
@@ -37,10 +19,10 @@ int fail(const std::string& message) {
 
 int main(int argc, char** argv) {
   if (argc != 3) return fail("usage: sidc_library_example MODEL.sid RECORD.csv");
-  std::ifstream file(argv[1]);
-  std::ostringstream text;
-  if (!(text << file.rdbuf())) return fail(fmt::format("error: cannot read `{}`", argv[1]));
-  CompileResult compiled = compile(std::make_shared<const SourceFile>(argv[1], text.str()), {});
+  std::string error;
+  auto text = read_whole_file(argv[1], error);
+  if (!text) return fail(error);
+  CompileResult compiled = compile(std::make_shared<const SourceFile>(argv[1], std::move(*text)), {});
   std::cerr << compiled.diagnostics.render_all();  // errors and warnings, as sidc shows them
   if (!compiled.ok()) return 1;
   const ir::Model& model = *compiled.integrated;  // the equations as fitted (`set integrate`)
@@ -50,8 +32,7 @@ int main(int argc, char** argv) {
   data.path = argv[2];
   auto record = read_csv(data.path);
   if (auto* d = std::get_if<Diagnostic>(&record)) return fail(render(*d));
-  const BindOptions bind{.step = settings.step, .every = settings.every, .weights = settings.weights};
-  auto bound = bind_record(std::get<Record>(std::move(record)), data, model, bind);
+  auto bound = bind_record(std::get<Record>(std::move(record)), data, model, bind_options(settings));
   if (auto* d = std::get_if<Diagnostic>(&bound)) return fail(render(*d));
 
   auto result = fit(model, {std::get<SampledRecord>(std::move(bound))}, fit_options(settings));

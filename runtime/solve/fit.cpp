@@ -11,12 +11,14 @@
 #include <chrono>
 #include <map>
 #include <numeric>
+#include <set>
 #include <thread>
 
 #include <time.h>
 
 #include "ir/print.hpp"
 #include "ir/queries.hpp"
+#include "ir/traversal.hpp"
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 
@@ -24,20 +26,23 @@ namespace sidc {
 
 namespace {
 
-void collect_guards(const ir::Sum& s, std::map<std::string, ir::Factor>& guards) {
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind == ir::FactorKind::guard) guards.emplace(print(f), f);
-      if (f.argument) collect_guards(*f.argument, guards);
-    }
-}
-
-// The group's guards by printed text: those its regions are told by (Table 4-1.1).
+// The group's guards by printed text: those its regions are told by (Table 4-1.1). A guard inside
+// another guard's condition shapes that guard's border and tells no region of its own.
 std::map<std::string, ir::Factor> guards_of(const ir::Model& model, const std::vector<std::size_t>& equations) {
   std::map<std::string, ir::Factor> guards;
+  std::set<const ir::Factor*> in_condition;  // met before their turn: the walk is outer before inner
+  const auto collect = [&](const ir::Sum& s) {
+    ir::for_each_factor(s, [&](const ir::Factor& f) {
+      if (f.kind != ir::FactorKind::guard || in_condition.count(&f)) return;
+      guards.emplace(print(f), f);
+      ir::for_each_nested_sum(f, [&](const ir::Sum& side) {
+        ir::for_each_factor(side, [&](const ir::Factor& inner) { in_condition.insert(&inner); });
+      });
+    });
+  };
   for (std::size_t e : equations) {
-    collect_guards(model.equations[e].known, guards);
-    for (const auto& p : model.equations[e].terms) collect_guards(p.operation, guards);
+    collect(model.equations[e].known);
+    for (const auto& p : model.equations[e].terms) collect(p.operation);
   }
   return guards;
 }

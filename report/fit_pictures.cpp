@@ -27,12 +27,14 @@ std::vector<std::string> input_names(const ir::Model& model) {
   return names;
 }
 
-// Fitted values by the model's parameter order (integration constants are no model parameters).
-std::vector<double> parameter_values(const ir::Model& model, const FitSummary& summary) {
-  std::vector<double> values(model.parameters.size(), std::numeric_limits<double>::quiet_NaN());
+// Fitted values by the normalized model's parameter order. The fit's model, the integrated one,
+// has the same parameters first and its integration constants after them (integrate_pass.cpp), and
+// those are no parameters of the normalized model.
+std::vector<double> parameter_values(const ir::Model& normalized, const FitSummary& summary) {
+  std::vector<double> values(normalized.parameters.size(), std::numeric_limits<double>::quiet_NaN());
   for (const auto& g : summary.groups)
     for (const auto& p : g.summary.parameters)
-      if (const int i = model.parameter_index(p.name); i >= 0) values[static_cast<std::size_t>(i)] = p.value;
+      if (p.index && !p.index->record && p.index->parameter < values.size()) values[p.index->parameter] = p.value;
   return values;
 }
 

@@ -1,7 +1,8 @@
-// The design matrix of one group of equations (thesis section 2-1: each operation of eq. 2-1.5
-// evaluated on the record, one row per sample and equation, one column per parameter, the known
-// side beside it, rows weighted by eq. 2-1.6), laid out and filled one way for the dense fit, the
-// streamed fit (runtime/solve/fit.cpp) and select (runtime/select/select.cpp).
+// The design matrix of one group of equations (thesis section 2-1: each operation op_k of the
+// linear form sum_k a_k op_k = known, eq. 2-1.2, evaluated on the record; one row per sample and
+// equation, one column per parameter, the known side beside it, rows weighted by eq. 2-1.6), laid
+// out and filled one way for the dense fit, the streamed fit (runtime/solve/fit.cpp) and select
+// (runtime/select/select.cpp).
 //
 // Relies on: a compiled model and its records bound to signals (bind_record.hpp); the operations'
 // values from an evaluator behind DesignValues: Evaluator on whole fit windows (evaluate.hpp) or
@@ -75,7 +76,8 @@ struct DesignBlock {
 
 class DesignBuilder {
  public:
-  // The design of the group `equations` (indices into the model's equations) over `records`.
+  // The design of the group `equations` (indices into the model's equations) over `records`;
+  // the model and the records must outlive the builder.
   DesignBuilder(const ir::Model& model, const std::vector<SampledRecord>& records, std::vector<std::size_t> equations);
 
   const std::vector<DesignColumn>& columns() const { return columns_; }
@@ -83,7 +85,6 @@ class DesignBuilder {
   std::vector<ParameterIndex> column_indices() const;
   // The column of `parameter` (index into the model's parameters) in the rows of `record`.
   std::size_t column(int parameter, std::size_t record) const;
-  const std::vector<std::size_t>& equations() const { return equations_; }
   // Every operation and known side of the group, equation by equation (what the whole-window
   // values of a row-block evaluator must cover).
   std::vector<const ir::Sum*> sums() const;
@@ -101,10 +102,10 @@ class DesignBuilder {
                                         Eigen::MatrixXd& A, Eigen::VectorXd& b, Eigen::VectorXd& weights,
                                         Eigen::Index row) const;
 
-  // eq. 2-1.6: the weights of `record`'s samples [first_sample, first_sample + out.size()): the
-  // record's weight column times `expression` (that many values of `set weights`, or empty). Null
-  // when neither is given (the rows are unweighted); the weight column itself when only it is;
-  // else `out` (which may be `expression`) holding the products.
+  // eq. 2-1.6: the weights of `record`'s rows from sample first_sample on: its weight column
+  // times `expression` (`set weights` on those rows; empty when the model sets none). Null when
+  // neither is given (the rows are unweighted); the weight column itself when only it is; else
+  // `out` (at least expression.size() long; it may be `expression`) holding the products.
   const double* row_weights(std::size_t record, std::size_t first_sample, std::span<const double> expression,
                             std::span<double> out) const;
 

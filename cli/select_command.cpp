@@ -122,7 +122,7 @@ int run_select(const SelectArguments& a) {
     if (equation_groups(model).size() != 1) return usage(cli_diag::simulate_needs_one_group());
     if (auto* d = std::get_if<Diagnostic>(&*compiled->explicit_form))
       return fail(render(cli_diag::simulate_needs_explicit_form(*d)), exit_code::user_error);
-    o.simulation_error = [&](std::size_t, const std::vector<std::string>& subset, const std::vector<double>& values) {
+    o.simulation_error = [&](std::size_t, const std::vector<ParameterIndex>& subset, const std::vector<double>& values) {
       return simulation_rms_error(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form), subset, values, records,
                                   o.fit.evaluation.derivative, a.simulate_samples);
     };

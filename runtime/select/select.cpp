@@ -1,25 +1,21 @@
 // Determination of operations over time-block triangles (see select.hpp).
 //
 // Relies on: evaluate.hpp (Evaluator, fit_window), fit.hpp (FitOptions, equation_groups),
-// triangular_accumulator.hpp, best_subset.hpp, sequential_threshold.hpp, forward_regression.hpp.
-// Guarantees: the header's. The rows of one record are evaluated column by column over the fit
-// window (as fit does), then cut into blocks and folded; memory is p x n doubles while one record
-// is evaluated, and O(F p^2) after.
+// design.hpp (the columns and rows), triangular_accumulator.hpp, best_subset.hpp,
+// sequential_threshold.hpp, forward_regression.hpp. Guarantees: the header's. The rows of one
+// record are built over its fit window as the dense fit builds them, then cut into blocks of time
+// and folded; memory is p x n doubles while one record is evaluated, and O(F p^2) after.
 #include "runtime/select/select.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <random>
-#include <set>
 
 #include <fmt/format.h>
 
-#include "ir/queries.hpp"
 #include "ir/print.hpp"
-#include "diagnostics/data_catalogue.hpp"
 #include "runtime/select/forward_regression.hpp"
 #include "runtime/select/sequential_threshold.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
@@ -210,29 +206,21 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     const auto started = std::chrono::steady_clock::now();
     GroupSelection g;
     g.equations = members;
-    // Columns, as fit: each parameter once, integration constants once per record.
-    std::map<std::pair<int, std::size_t>, std::size_t> column_of;
+    // Columns and rows as fit has them (design.hpp).
+    const DesignBuilder design(model, records, members);
+    g.columns = design.column_names();
+    g.column_parameters = design.column_indices();
+    std::vector<std::string> base_name;  // the parameter's name, for `required`, `groups` and `dropped`
     std::vector<char> constant;
-    auto per_record = [&](int p) {
-      return model.parameters[static_cast<std::size_t>(p)].origin == ir::Parameter::Origin::integration_constant && records.size() > 1;
-    };
-    std::set<int> used;
-    for (std::size_t e : members)
-      for (const auto& p : model.equations[e].terms) used.insert(p.parameter);
-    std::vector<std::string> base_name;
-    for (int p : used) {
-      const auto& parameter = model.parameters[static_cast<std::size_t>(p)];
-      for (std::size_t r = 0; r < (per_record(p) ? records.size() : 1); ++r) {
-        column_of[{p, per_record(p) ? r : 0}] = g.columns.size();
-        g.columns.push_back(per_record(p) ? fmt::format("{}@{}", parameter.name, r + 1) : parameter.name);
-        base_name.push_back(parameter.name);
-        constant.push_back(parameter.origin == ir::Parameter::Origin::integration_constant);
-        std::string operation;
-        for (std::size_t e : members)
-          for (const auto& t : model.equations[e].terms)
-            if (t.parameter == p) operation += (operation.empty() ? "" : "; ") + print(t.operation);
-        g.operations.push_back(operation);
-      }
+    for (const DesignColumn& c : design.columns()) {
+      const ir::Parameter& parameter = model.parameters[c.index.parameter];
+      base_name.push_back(parameter.name);
+      constant.push_back(parameter.origin == ir::Parameter::Origin::integration_constant);
+      std::string operation;
+      for (std::size_t e : members)
+        for (const auto& t : model.equations[e].terms)
+          if (static_cast<std::size_t>(t.parameter) == c.index.parameter) operation += (operation.empty() ? "" : "; ") + print(t.operation);
+      g.operations.push_back(operation);
     }
     const auto p = static_cast<int>(g.columns.size());
 
@@ -241,48 +229,34 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     std::vector<TriangularAccumulator> blocks(static_cast<std::size_t>(fine), TriangularAccumulator(p));
     for (std::size_t r = 0; r < records.size(); ++r) {
       Evaluator evaluator(records[r], model, options.fit.evaluation, windows[r]);
-      const FitWindow& w = windows[r];
-      const std::size_t W = w.size(), E = members.size();
+      const std::size_t W = windows[r].size(), E = members.size();
       Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(W * E), p);
       Eigen::VectorXd b(static_cast<Eigen::Index>(W * E));
       Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(W * E));
-      // eq. 2-1.6 as sidc fit applies it: the column's weights times the expression's.
-      std::vector<double> expression;
+      std::vector<double> expression;  // eq. 2-1.6 as sidc fit applies it
       if (model.weights) {
         auto values = expression_weights(model, evaluator);
         if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
         expression = std::get<std::vector<double>>(std::move(values));
       }
-      // Row of (equation k, sample i) is i * E + k, so that a block of samples is a block of rows.
-      for (std::size_t k = 0; k < E; ++k) {
-        const ir::Equation& eq = model.equations[members[k]];
-        for (const auto& term : eq.terms) {
-          const auto& parameter = model.parameters[static_cast<std::size_t>(term.parameter)];
-          const std::size_t column = column_of.at({term.parameter, per_record(term.parameter) ? r : 0});
-          auto values = evaluator.evaluate_in_window(term.operation, "the operation of `" + parameter.name + "`");
-          if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-          const auto& v = std::get<std::vector<double>>(values);
-          for (std::size_t i = 0; i < W; ++i) A(static_cast<Eigen::Index>(i * E + k), static_cast<Eigen::Index>(column)) = v[i];
-        }
-        auto known = evaluator.evaluate_in_window(eq.known, "the known side");
-        if (auto* d = std::get_if<Diagnostic>(&known)) return *d;
-        const auto& v = std::get<std::vector<double>>(known);
-        for (std::size_t i = 0; i < W; ++i) {
-          b(static_cast<Eigen::Index>(i * E + k)) = v[i];
-          double weight = records[r].weights.empty() ? 1.0 : records[r].weights[w.first + i];
-          if (!expression.empty()) weight *= expression[i];
-          weights(static_cast<Eigen::Index>(i * E + k)) = weight;
-        }
-      }
+      if (auto problem = design.window_rows(r, evaluator, expression, A, b, weights, 0)) return *problem;
       const bool weighted = !records[r].weights.empty() || !expression.empty();
       for (int block = 0; block < fine; ++block) {
         const std::size_t first = W * static_cast<std::size_t>(block) / static_cast<std::size_t>(fine);
         const std::size_t last = W * static_cast<std::size_t>(block + 1) / static_cast<std::size_t>(fine);
         if (last <= first) continue;
-        const auto row0 = static_cast<Eigen::Index>(first * E), rows = static_cast<Eigen::Index>((last - first) * E);
-        const Eigen::MatrixXd Ab = A.middleRows(row0, rows);
-        const Eigen::VectorXd bb = b.segment(row0, rows);
-        const Eigen::VectorXd wb = weights.segment(row0, rows);
+        // The design holds equation k's row of sample i at k W + i; a block of time folds sample
+        // by sample, row (i, k) at i E + k.
+        const auto rows = static_cast<Eigen::Index>((last - first) * E);
+        Eigen::MatrixXd Ab(rows, p);
+        Eigen::VectorXd bb(rows), wb(rows);
+        for (std::size_t i = first; i < last; ++i)
+          for (std::size_t k = 0; k < E; ++k) {
+            const auto from = static_cast<Eigen::Index>(k * W + i), to = static_cast<Eigen::Index>((i - first) * E + k);
+            Ab.row(to) = A.row(from);
+            bb(to) = b(from);
+            wb(to) = weights(from);
+          }
         std::string why;
         if (!blocks[static_cast<std::size_t>(block)].add_rows(Ab, bb, weighted ? &wb : nullptr, &why)) {
           summary.message = fmt::format("rows of `{}` could not be folded: {}", records[r].path, why);
@@ -295,9 +269,7 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     const TriangularSystem full_system = merged(blocks, all, p);
     g.n = full_system.rows;
     g.blocks = static_cast<std::size_t>(fine);
-    if (g.n < static_cast<std::size_t>(p))
-      return diag::window_too_short(records.front().path, g.n, static_cast<std::size_t>(p),
-                                    samples_lost_each_side(std::max(1, highest_derivative_order(model)), options.fit.evaluation.derivative));
+    if (auto problem = design.too_few_rows(g.n, options.fit.evaluation)) return *problem;
 
     // Kept columns (not dropped), required ones, groups: by name.
     std::vector<int> kept;
@@ -381,7 +353,9 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
       row.size = static_cast<int>(k);
       const SubsetSolution solution = solve_subset(system, best.columns);
       for (std::size_t j = 0; j < best.columns.size(); ++j) {
-        row.parameters.push_back(kept_names[static_cast<std::size_t>(best.columns[j])]);
+        const auto c = static_cast<std::size_t>(kept[static_cast<std::size_t>(best.columns[j])]);
+        row.parameters.push_back(g.columns[c]);
+        row.indices.push_back(g.column_parameters[c]);
         row.values.push_back(solution.coefficients[j]);
       }
       row.rank = solution.rank;
@@ -391,7 +365,7 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
       row.aic = aic_of(G, n, static_cast<double>(k));
       row.bic = bic_of(G, n, static_cast<double>(k));
       row.cv = kNaN;
-      if (options.simulation_error) row.simulation = options.simulation_error(summary.groups.size(), row.parameters, row.values);
+      if (options.simulation_error) row.simulation = options.simulation_error(summary.groups.size(), row.indices, row.values);
       g.rows.push_back(std::move(row));
     }
 
@@ -445,9 +419,9 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     g.best_simulation = argmin(g.rows, [](const SizeRow& r) { return r.simulation.value_or(kNaN); });
     g.chosen = options.rule == SizeRule::aic ? g.best_aic : options.rule == SizeRule::bic ? g.best_bic : g.best_cv;
     if (g.chosen >= 0) {
-      const auto& chosen = g.rows[static_cast<std::size_t>(g.chosen)].parameters;
+      const auto& chosen = g.rows[static_cast<std::size_t>(g.chosen)].indices;
       for (int c : kept)
-        if (std::find(chosen.begin(), chosen.end(), g.columns[static_cast<std::size_t>(c)]) == chosen.end())
+        if (std::find(chosen.begin(), chosen.end(), g.column_parameters[static_cast<std::size_t>(c)]) == chosen.end())
           g.non_contributory.push_back(g.columns[static_cast<std::size_t>(c)]);
     }
 

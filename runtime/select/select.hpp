@@ -4,9 +4,9 @@
 // non-contributory, and say how stable the choice is by a bootstrap over time blocks.
 //
 // Relies on: a compiled model and records bound to its signals (as fit: runtime/solve/fit.hpp,
-// FitOptions), the Evaluator (evaluate.hpp) for the columns, TriangularAccumulator for one
-// triangle per block of time, and the three search methods on triangles: best_subset.hpp (exact),
-// sequential_threshold.hpp (STLSQ), forward_regression.hpp (FROLS).
+// FitOptions), the design builder (runtime/solve/design.hpp) for the columns and rows,
+// TriangularAccumulator for one triangle per block of time, and the three search methods on
+// triangles: best_subset.hpp (exact), sequential_threshold.hpp (STLSQ), forward_regression.hpp (FROLS).
 //
 // Guarantees:
 // - The rows are those fit uses (same window, weights, groups of equations sharing parameters,
@@ -74,10 +74,10 @@ struct SelectOptions {
   double tolerance = 1e-10;           // of the exact search, relative to G(0) (best_subset.hpp)
 
   // Hook for ranking by free-run simulation error (runtime/simulate/): when set, called
-  // for the best subset of every size with the parameter names and values of that subset (all
-  // others zero) and the group index; its value (smaller is better) is reported in a `sim` column
+  // for the best subset of every size with the parameters (their indices) and values of that
+  // subset (all others zero) and the group index; its value (smaller is better) is reported in a `sim` column
   // and can be the size rule later. sidc select --simulate sets it (cli/select_command.cpp).
-  std::function<std::optional<double>(std::size_t group, const std::vector<std::string>& names, const std::vector<double>& values)>
+  std::function<std::optional<double>(std::size_t group, const std::vector<ParameterIndex>& parameters, const std::vector<double>& values)>
       simulation_error;
 
   bool is_valid(std::string* why) const;
@@ -86,6 +86,7 @@ struct SelectOptions {
 struct SizeRow {
   int size = 0;                          // parameters in the subset
   std::vector<std::string> parameters;   // the best subset of this size
+  std::vector<ParameterIndex> indices;   // beside parameters: the model parameter (and record) of each
   std::vector<double> values;            // their least-squares values
   int rank = 0;
   double G = 0;                          // eq. 2-1.7
@@ -99,6 +100,7 @@ struct SizeRow {
 struct GroupSelection {
   std::vector<std::size_t> equations;
   std::vector<std::string> columns;        // every parameter of the group
+  std::vector<ParameterIndex> column_parameters;  // beside columns: the model parameter (and record) of each
   std::vector<std::string> operations;     // the operation each column multiplies, printed
   std::vector<std::string> required, dropped;  // by column name
   std::size_t n = 0;

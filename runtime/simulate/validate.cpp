@@ -145,12 +145,13 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   return v;
 }
 
-std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<std::string>& subset,
+std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<ParameterIndex>& subset,
                                            const std::vector<double>& values, const std::vector<SampledRecord>& records,
                                            const DerivativeOptions& derivative, std::size_t max_samples) {
   std::vector<double> parameters(normalized.parameters.size(), 0.0);
   for (std::size_t i = 0; i < subset.size(); ++i)
-    if (const int k = normalized.parameter_index(subset[i]); k >= 0) parameters[static_cast<std::size_t>(k)] = values[i];
+    // The derivative form's parameters come first in the fitted model's order (integrate_pass.cpp).
+    if (!subset[i].record && subset[i].parameter < parameters.size()) parameters[subset[i].parameter] = values[i];
   ValidationOptions v;
   v.derivative = derivative;
   v.max_samples = max_samples;

@@ -81,10 +81,10 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
                            std::size_t max_samples);
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
-// with `values` for the parameters named in `subset` (the others 0) from each record, scored by the
+// with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record, scored by the
 // RMS error over outputs and records; infinity when a run diverges, nullopt when a record cannot
 // be compared.
-std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<std::string>& subset,
+std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<ParameterIndex>& subset,
                                            const std::vector<double>& values, const std::vector<SampledRecord>& records,
                                            const DerivativeOptions& derivative, std::size_t max_samples);
 

@@ -1,3 +1,9 @@
+// The fit (see fit.hpp): per group of equations, the design from design.hpp solved dense or
+// streamed, and the rows counted by region.
+//
+// Relies on: design.hpp (columns, rows, weights and their checks), evaluate.hpp and
+// block_evaluator.hpp (the values), least_squares.hpp and triangular_accumulator.hpp (the solve).
+// Guarantees: fit.hpp's; the streamed path reports the problem the dense path would meet first.
 #include "runtime/solve/fit.hpp"
 
 #include <fmt/format.h>
@@ -10,9 +16,9 @@
 
 #include <time.h>
 
-#include "ir/queries.hpp"
 #include "ir/print.hpp"
-#include "diagnostics/data_catalogue.hpp"
+#include "ir/queries.hpp"
+#include "ir/traversal.hpp"
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 
@@ -20,22 +26,31 @@ namespace sidc {
 
 namespace {
 
-void collect_guards(const ir::Sum& s, std::map<std::string, ir::Factor>& guards) {
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind == ir::FactorKind::guard) guards.emplace(print(f), f);
-      if (f.argument) collect_guards(*f.argument, guards);
-    }
+// The group's guards by printed text: those its regions are told by (Table 4-1.1). A guard inside
+// another guard's condition shapes that guard's border and tells no region of its own.
+std::map<std::string, ir::Factor> guards_of(const ir::Model& model, const std::vector<std::size_t>& equations) {
+  std::map<std::string, ir::Factor> guards;
+  std::set<const ir::Factor*> in_condition;  // met before their turn: the walk is outer before inner
+  const auto collect = [&](const ir::Sum& s) {
+    ir::for_each_factor(s, [&](const ir::Factor& f) {
+      if (f.kind != ir::FactorKind::guard || in_condition.count(&f)) return;
+      guards.emplace(print(f), f);
+      ir::for_each_nested_sum(f, [&](const ir::Sum& side) {
+        ir::for_each_factor(side, [&](const ir::Factor& inner) { in_condition.insert(&inner); });
+      });
+    });
+  };
+  for (std::size_t e : equations) {
+    collect(model.equations[e].known);
+    for (const auto& p : model.equations[e].terms) collect(p.operation);
+  }
+  return guards;
 }
 
 // Counts the rows of each record's window by which of the group's guards hold there.
 std::variant<std::vector<Region>, Diagnostic> count_regions(const ir::Model& model, const std::vector<std::size_t>& equations,
                                                            std::vector<Evaluator>& evaluators) {
-  std::map<std::string, ir::Factor> guards;
-  for (std::size_t e : equations) {
-    collect_guards(model.equations[e].known, guards);
-    for (const auto& p : model.equations[e].terms) collect_guards(p.operation, guards);
-  }
+  const std::map<std::string, ir::Factor> guards = guards_of(model, equations);
   std::vector<Region> regions;
   if (guards.empty()) return regions;
   std::map<std::string, std::size_t> counts;
@@ -59,51 +74,13 @@ std::variant<std::vector<Region>, Diagnostic> count_regions(const ir::Model& mod
   return regions;
 }
 
-// The design's columns: each parameter once; integration constants once per record.
-struct GroupLayout {
-  std::vector<std::string> columns;
-  std::map<std::pair<int, std::size_t>, std::size_t> column_of;  // (parameter, record or 0) -> column
-  bool several_records = false;
-  const ir::Model* model = nullptr;
-  bool per_record(int p) const {
-    return model->parameters[static_cast<std::size_t>(p)].origin == ir::Parameter::Origin::integration_constant && several_records;
-  }
-  std::size_t column(int p, std::size_t record) const { return column_of.at({p, per_record(p) ? record : 0}); }
-};
-
-GroupLayout layout_of(const ir::Model& model, const std::vector<std::size_t>& members, std::size_t record_count) {
-  GroupLayout g;
-  g.model = &model;
-  g.several_records = record_count > 1;
-  std::set<int> used;
-  for (std::size_t e : members)
-    for (const auto& p : model.equations[e].terms) used.insert(p.parameter);
-  for (int p : used) {
-    const auto& parameter = model.parameters[static_cast<std::size_t>(p)];
-    for (std::size_t r = 0; r < (g.per_record(p) ? record_count : 1); ++r) {
-      g.column_of[{p, g.per_record(p) ? r : 0}] = g.columns.size();
-      g.columns.push_back(g.per_record(p) ? fmt::format("{}@{}", parameter.name, r + 1) : parameter.name);
-    }
-  }
-  return g;
-}
-
-// eq. 2-1.6 with `set weights = <expression>`: every row's weight must be a finite number >= 0.
-std::optional<Diagnostic> invalid_weight(const ir::Model& model, const SampledRecord& record, std::span<const double> values,
-                                         std::size_t first_sample) {
-  for (std::size_t i = 0; i < values.size(); ++i)
-    if (!std::isfinite(values[i]) || values[i] < 0)
-      return diag::weight_not_valid(model.weights->span, print(model.weights->value), values[i], record.time[first_sample + i], record.path);
-  return std::nullopt;
-}
-
 // What the streamed path needs besides the model and the records, shared read-only by its threads.
 struct StreamPlan {
   const ir::Model& model;
   const std::vector<SampledRecord>& records;
   const std::vector<FitWindow>& windows;
   const FitOptions& options;
-  const GroupLayout& layout;
+  const DesignBuilder& design;
   std::vector<WholeWindowValues> whole;  // per record
   std::vector<std::string> guard_texts;  // the group's guards, in count_regions' order
   std::vector<ir::Sum> guard_sums;
@@ -112,17 +89,45 @@ struct StreamPlan {
 // Where the first problem lies in the dense path's order of evaluation: operation (the known side
 // after the operations), term, sample + 1 (0: a problem that is not a value, found on evaluating).
 using ProblemKey = std::tuple<std::size_t, std::size_t, std::size_t>;
+using Problem = std::optional<std::pair<ProblemKey, Diagnostic>>;
+
+void keep_first(Problem& slot, ProblemKey key, Diagnostic d) {
+  if (!slot || key < slot->first) slot.emplace(key, std::move(d));
+}
+
+// Row blocks as the design's values. With a slot (the streamed fit), every problem is kept there
+// by ProblemKey and the rows go on, since a later block may hold the one the dense path meets
+// first; without (the residual pass, over rows the fit accepted), a structural problem stops.
+class BlockValues final : public DesignValues {
+ public:
+  BlockValues(BlockEvaluator& evaluator, const SampledRecord& record, const FitWindow& window, Problem* problems)
+      : evaluator_(evaluator), record_(record), window_(window), problems_(problems) {}
+
+  std::optional<Diagnostic> evaluate(const ir::Sum& sum, std::size_t index, const std::string& what, std::span<double> out) override {
+    std::optional<NonFiniteValue> bad;
+    auto status = evaluator_.evaluate(sum, out, problems_ ? &bad : nullptr);
+    if (auto* d = std::get_if<Diagnostic>(&status)) {
+      if (!problems_) return std::move(*d);
+      keep_first(*problems_, {index, 0, 0}, std::move(*d));
+    } else if (bad) {
+      keep_first(*problems_, {index, bad->term, bad->sample - window_.first + 1}, non_finite_value(record_, sum, *bad, what));
+    }
+    return std::nullopt;
+  }
+
+ private:
+  BlockEvaluator& evaluator_;
+  const SampledRecord& record_;
+  const FitWindow& window_;
+  Problem* problems_;
+};
 
 struct StreamWorker {
   explicit StreamWorker(int p) : accumulator(p) {}
   TriangularAccumulator accumulator;
   std::map<std::string, std::size_t> region_rows;  // by a '0'/'1' string, one character per guard
-  std::optional<std::pair<ProblemKey, Diagnostic>> problem, guard_problem;
+  Problem problem, guard_problem;
   double evaluate_seconds = 0, fold_seconds = 0;
-
-  void note(std::optional<std::pair<ProblemKey, Diagnostic>>& slot, ProblemKey key, Diagnostic d) {
-    if (!slot || key < slot->first) slot.emplace(key, std::move(d));
-  }
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -142,11 +147,11 @@ void stream_rows(const StreamPlan& plan, StreamWorker& worker, std::size_t r, st
                  bool count_regions) {
   const SampledRecord& record = plan.records[r];
   const FitWindow& w = plan.windows[r];
-  const ir::Equation& eq = plan.model.equations[e];
-  const auto p = static_cast<Eigen::Index>(plan.layout.columns.size());
+  const auto p = static_cast<Eigen::Index>(plan.design.columns().size());
   BlockEvaluator evaluator(record, plan.options.evaluation, w, plan.whole[r]);
+  BlockValues values(evaluator, record, w, &worker.problem), guard_values(evaluator, record, w, &worker.guard_problem);
   const std::size_t block_rows = std::max<std::size_t>(plan.options.stream_block_rows, 1);
-  std::vector<double> guard_values(count_regions ? plan.guard_sums.size() * block_rows : 0);
+  std::vector<double> guards(count_regions ? plan.guard_sums.size() * block_rows : 0);
   std::string key(plan.guard_sums.size(), '0');
   std::vector<double> weight_values(plan.model.weights ? block_rows : 0);
   for (std::size_t start = begin; start < end; start += block_rows) {
@@ -156,52 +161,29 @@ void stream_rows(const StreamPlan& plan, StreamWorker& worker, std::size_t r, st
     evaluator.start_block(first, first + m);
     auto area = worker.accumulator.rows_area(static_cast<Eigen::Index>(m));
     area.setZero();
-    bool ok = true;
-    const auto evaluate = [&](const ir::Sum& sum, std::span<double> out, std::size_t index, const std::string& what,
-                              std::optional<std::pair<ProblemKey, Diagnostic>>& slot) {
-      std::optional<NonFiniteValue> bad;
-      auto status = evaluator.evaluate(sum, out, &bad);
-      if (auto* d = std::get_if<Diagnostic>(&status)) {
-        worker.note(slot, {index, 0, 0}, std::move(*d));
-        ok = false;
-      } else if (bad) {
-        const ir::Term& t = sum.terms[bad->term];
-        const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
-        worker.note(slot, {index, bad->term, bad->sample - w.first + 1},
-                    diag::operation_not_finite(t.span, print(single), what, record.time[bad->sample], record.path));
-        ok = false;
-      }
-    };
-    for (std::size_t k = 0; k < eq.terms.size(); ++k) {
-      const auto& term = eq.terms[k];
-      const auto column = static_cast<Eigen::Index>(plan.layout.column(term.parameter, r));
-      const auto& name = plan.model.parameters[static_cast<std::size_t>(term.parameter)].name;
-      evaluate(term.operation, std::span<double>(area.col(column).data(), m), k, "the operation of `" + name + "`", worker.problem);
-    }
-    evaluate(eq.known, std::span<double>(area.col(p).data(), m), eq.terms.size(), "the known side", worker.problem);
+    plan.design.equation_rows(r, e, values, {area.leftCols(p), area.col(p)});  // problems go to worker.problem
     if (count_regions && !plan.guard_sums.empty()) {
       for (std::size_t g = 0; g < plan.guard_sums.size(); ++g)
-        evaluate(plan.guard_sums[g], std::span<double>(guard_values.data() + g * block_rows, m), r * plan.guard_sums.size() + g,
-                 "a region guard", worker.guard_problem);
+        guard_values.evaluate(plan.guard_sums[g], r * plan.guard_sums.size() + g, "a region guard",
+                              std::span<double>(guards.data() + g * block_rows, m));
       for (std::size_t i = 0; i < m; ++i) {
-        for (std::size_t g = 0; g < plan.guard_sums.size(); ++g) key[g] = guard_values[g * block_rows + i] != 0.0 ? '1' : '0';
+        for (std::size_t g = 0; g < plan.guard_sums.size(); ++g) key[g] = guards[g * block_rows + i] != 0.0 ? '1' : '0';
         ++worker.region_rows[key];
       }
     }
     const double evaluated = thread_cpu_seconds();
     worker.evaluate_seconds += evaluated - clock;
-    if (!ok || worker.problem || worker.guard_problem) continue;  // the fit ends in a diagnostic: fold nothing more
-    const double* weights = record.weights.empty() ? nullptr : record.weights.data() + first;
+    if (worker.problem || worker.guard_problem) continue;  // the fit ends in a diagnostic: fold nothing more
+    std::span<const double> expression;
     if (plan.model.weights) {  // checked before streaming (stream_group), so only multiplied here
       auto status = evaluator.evaluate(plan.model.weights->value, std::span<double>(weight_values.data(), m));
       if (auto* d = std::get_if<Diagnostic>(&status)) {  // not after stream_group's check, but never drop rows silently
-        worker.note(worker.problem, {0, 0, 0}, std::move(*d));
+        keep_first(worker.problem, {0, 0, 0}, std::move(*d));
         continue;
       }
-      if (weights)
-        for (std::size_t i = 0; i < m; ++i) weight_values[i] *= weights[i];
-      weights = weight_values.data();
+      expression = std::span<const double>(weight_values.data(), m);
     }
+    const double* weights = plan.design.row_weights(r, first, expression, weight_values);
     // A rejected block (not finite, negative weight) cannot pass the checks above; if one did, the
     // accumulator counts it and solve() says invalid_input.
     worker.accumulator.fold_rows_area(static_cast<Eigen::Index>(m), weights);
@@ -217,22 +199,13 @@ int stream_thread_count(const FitOptions& options) {
 // The streamed path for one group (FitOptions::stream_above_entries).
 std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector<SampledRecord>& records,
                                        const std::vector<FitWindow>& windows, const FitOptions& options,
-                                       const GroupLayout& layout, std::size_t total_rows, GroupFit& g) {
-  StreamPlan plan{model, records, windows, options, layout, {}, {}, {}};
-  std::map<std::string, ir::Factor> guards;
-  for (std::size_t e : g.equations) {
-    collect_guards(model.equations[e].known, guards);
-    for (const auto& p : model.equations[e].terms) collect_guards(p.operation, guards);
-  }
-  for (const auto& [text, f] : guards) {
+                                       const DesignBuilder& design, std::size_t total_rows, GroupFit& g) {
+  StreamPlan plan{model, records, windows, options, design, {}, {}, {}};
+  for (const auto& [text, f] : guards_of(model, g.equations)) {
     plan.guard_texts.push_back(text);
     plan.guard_sums.push_back(ir::factor(f));
   }
-  std::vector<const ir::Sum*> sums;
-  for (std::size_t e : g.equations) {
-    for (const auto& p : model.equations[e].terms) sums.push_back(&p.operation);
-    sums.push_back(&model.equations[e].known);
-  }
+  std::vector<const ir::Sum*> sums = design.sums();
   for (const auto& s : plan.guard_sums) sums.push_back(&s);
   if (model.weights) sums.push_back(&model.weights->value);
   for (std::size_t r = 0; r < records.size(); ++r) {
@@ -252,13 +225,13 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
         evaluator.start_block(first, first + m);
         auto status = evaluator.evaluate(model.weights->value, std::span<double>(values.data(), m));
         if (auto* d = std::get_if<Diagnostic>(&status)) return *d;
-        if (auto problem = invalid_weight(model, records[r], std::span<const double>(values.data(), m), first)) return *problem;
+        if (auto problem = check_weights(model, records[r], std::span<const double>(values.data(), m), first)) return *problem;
       }
     }
   }
 
   const int threads = stream_thread_count(options);
-  const int p = static_cast<int>(layout.columns.size());
+  const int p = static_cast<int>(design.columns().size());
   std::vector<StreamWorker> workers;
   for (int k = 0; k < threads; ++k) workers.emplace_back(p);
   const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
@@ -279,7 +252,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
       stream_rows(plan, workers[0], r, e, 0, std::min(n, blocks / parts * block_rows), count);
       for (auto& t : running) t.join();
       // The dense path's first problem: the smallest key over the parts of this record and equation.
-      std::optional<std::pair<ProblemKey, Diagnostic>> first;
+      Problem first;
       for (auto& w : workers)
         if (w.problem && (!first || w.problem->first < first->first)) first = w.problem;
       if (first) return first->second;
@@ -288,7 +261,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   // count_regions runs after the whole design: a guard's problem only after every operation of
   // every record, ranked by record, guard and row as count_regions meets them.
   {
-    std::optional<std::pair<ProblemKey, Diagnostic>> first;
+    Problem first;
     for (auto& w : workers)
       if (w.guard_problem && (!first || w.guard_problem->first < first->first)) first = w.guard_problem;
     if (first) return first->second;
@@ -302,14 +275,13 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
       counts[text.empty() ? "(no guard)" : text] += rows;
     }
   for (auto& [text, rows] : counts) g.regions.push_back({text, rows});
-  if (total_rows < layout.columns.size())
-    return diag::window_too_short(records.front().path, total_rows, layout.columns.size(),
-                                  samples_lost_each_side(std::max(1, highest_derivative_order(model)), options.evaluation.derivative));
+  if (auto problem = design.too_few_rows(total_rows, options.evaluation)) return problem;
 
   for (std::size_t k = 1; k < workers.size(); ++k) workers[0].accumulator.merge(workers[k].accumulator);
   const auto clock = std::chrono::steady_clock::now();
-  g.summary = workers[0].accumulator.solve(layout.columns, options.least_squares);
+  g.summary = workers[0].accumulator.solve(g.columns, options.least_squares);
   g.solve_seconds = seconds_since(clock);
+  design.label(g.summary);
   for (const auto& w : workers) {
     g.evaluate_seconds += w.evaluate_seconds;
     g.fold_seconds += w.fold_seconds;
@@ -320,17 +292,6 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
 }
 
 }  // namespace
-
-// The row weights of one record from the expression, on its fit window, checked.
-std::variant<std::vector<double>, Diagnostic> expression_weights(const ir::Model& model, Evaluator& evaluator) {
-  auto values = evaluator.evaluate(model.weights->value);
-  if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-  const auto& v = std::get<std::vector<double>>(values);
-  const FitWindow& w = evaluator.window();
-  std::vector<double> window(v.begin() + static_cast<std::ptrdiff_t>(w.first), v.begin() + static_cast<std::ptrdiff_t>(w.first + w.size()));
-  if (auto problem = invalid_weight(model, evaluator.record(), window, w.first)) return *problem;
-  return window;
-}
 
 bool FitOptions::is_valid(std::string* why) const {
   if (from && to && *from > *to) {
@@ -384,68 +345,53 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
   for (const auto& members : equation_groups(model)) {
     GroupFit g;
     g.equations = members;
-    const GroupLayout layout = layout_of(model, members, records.size());
-    g.columns = layout.columns;
-    const auto& column_of = layout.column_of;
-    const auto per_record = [&](int p) { return layout.per_record(p); };
+    const DesignBuilder design(model, records, members);
+    g.columns = design.column_names();
+    g.column_parameters = design.column_indices();
     std::size_t total_rows = 0;
-    for (std::size_t r = 0; r < records.size(); ++r) total_rows += windows[r].size() * members.size();
+    for (std::size_t r = 0; r < records.size(); ++r) {
+      const FitWindow& w = windows[r];
+      total_rows += w.size() * members.size();
+      g.records.push_back({records[r].path, records[r].time[w.first], records[r].time[w.last], records[r].step, w.first, w.size()});
+    }
     g.weighted = model.weights || std::any_of(records.begin(), records.end(), [](const SampledRecord& r) { return !r.weights.empty(); });
     if (total_rows * g.columns.size() > options.stream_above_entries) {
-      for (std::size_t r = 0; r < records.size(); ++r) {
-        const FitWindow& w = windows[r];
-        g.records.push_back({records[r].path, records[r].time[w.first], records[r].time[w.last], records[r].step, w.first, w.size()});
-      }
-      if (auto problem = stream_group(model, records, windows, options, layout, total_rows, g)) return *problem;
+      if (auto problem = stream_group(model, records, windows, options, design, total_rows, g)) return *problem;
       summary.groups.push_back(std::move(g));
       continue;
     }
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(total_rows), static_cast<Eigen::Index>(g.columns.size()));
     Eigen::VectorXd b(static_cast<Eigen::Index>(total_rows));
     Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(total_rows));
-    const bool weighted = g.weighted;
     std::vector<std::vector<double>> weights_of_expression(model.weights ? records.size() : 0);  // per record, on its window
     for (std::size_t r = 0; r < weights_of_expression.size(); ++r) {
       auto values = expression_weights(model, evaluators[r]);
       if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
       weights_of_expression[r] = std::get<std::vector<double>>(std::move(values));
     }
-    std::size_t row = 0;
+    g.row_equation.reserve(total_rows);
+    g.row_record.reserve(total_rows);
+    g.row_time.reserve(total_rows);
+    g.known.reserve(total_rows);
+    Eigen::Index row = 0;
     for (std::size_t r = 0; r < records.size(); ++r) {
+      const std::span<const double> expression = model.weights ? std::span<const double>(weights_of_expression[r]) : std::span<const double>();
+      if (auto problem = design.window_rows(r, evaluators[r], expression, A, b, weights, row)) return *problem;
       const FitWindow& w = windows[r];
-      g.records.push_back({records[r].path, records[r].time[w.first], records[r].time[w.last], records[r].step, w.first, w.size()});
-      for (std::size_t e : members) {
-        const ir::Equation& eq = model.equations[e];
-        for (const auto& p : eq.terms) {
-          const auto& parameter = model.parameters[static_cast<std::size_t>(p.parameter)];
-          const std::size_t column = column_of.at({p.parameter, per_record(p.parameter) ? r : 0});
-          auto values = evaluators[r].evaluate_in_window(p.operation, "the operation of `" + parameter.name + "`");
-          if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-          const auto& v = std::get<std::vector<double>>(values);
-          for (std::size_t i = 0; i < v.size(); ++i) A(static_cast<Eigen::Index>(row + i), static_cast<Eigen::Index>(column)) = v[i];
-        }
-        auto known = evaluators[r].evaluate_in_window(eq.known, "the known side");
-        if (auto* d = std::get_if<Diagnostic>(&known)) return *d;
-        const auto& k = std::get<std::vector<double>>(known);
-        for (std::size_t i = 0; i < k.size(); ++i) {
-          b(static_cast<Eigen::Index>(row + i)) = k[i];
-          if (!records[r].weights.empty()) weights(static_cast<Eigen::Index>(row + i)) = records[r].weights[w.first + i];
-          if (model.weights) weights(static_cast<Eigen::Index>(row + i)) *= weights_of_expression[r][i];
+      for (std::size_t e : members)
+        for (std::size_t i = 0; i < w.size(); ++i, ++row) {
           g.row_equation.push_back(e);
           g.row_record.push_back(r);
           g.row_time.push_back(records[r].time[w.first + i]);
-          g.known.push_back(k[i]);
+          g.known.push_back(b(row));
         }
-        row += k.size();
-      }
     }
     auto regions = count_regions(model, members, evaluators);
     if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
     g.regions = std::get<std::vector<Region>>(std::move(regions));
-    if (total_rows < g.columns.size())
-      return diag::window_too_short(records.front().path, total_rows, g.columns.size(),
-                                    samples_lost_each_side(std::max(1, highest_derivative_order(model)), options.evaluation.derivative));
-    g.summary = solve_least_squares(A, b, g.columns, weighted ? &weights : nullptr, options.least_squares);
+    if (auto problem = design.too_few_rows(total_rows, options.evaluation)) return *problem;
+    g.summary = solve_least_squares(A, b, g.columns, g.weighted ? &weights : nullptr, options.least_squares);
+    design.label(g.summary);
     summary.groups.push_back(std::move(g));
   }
   return summary;
@@ -470,8 +416,8 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
     return std::nullopt;
   }
   // Streamed: evaluate every block again, as stream_rows did, and apply the estimates.
-  const GroupLayout layout = layout_of(model, g.equations, records.size());
-  const auto p = static_cast<Eigen::Index>(layout.columns.size());
+  const DesignBuilder design(model, records, g.equations);
+  const auto p = static_cast<Eigen::Index>(design.columns().size());
   const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
   Eigen::MatrixXd A(static_cast<Eigen::Index>(block_rows), p);
   Eigen::VectorXd b(static_cast<Eigen::Index>(block_rows));
@@ -484,29 +430,18 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
     // of the whole record) of the first rows do not depend on where the window ends.
     if (w.size() > remaining) w.last = w.first + remaining - 1;
     remaining -= w.size();
-    std::vector<const ir::Sum*> sums;
-    for (std::size_t e : g.equations) {
-      for (const auto& term : model.equations[e].terms) sums.push_back(&term.operation);
-      sums.push_back(&model.equations[e].known);
-    }
-    auto whole = prepare_whole_window_values(records[r], model, options.evaluation, w, sums);
+    auto whole = prepare_whole_window_values(records[r], model, options.evaluation, w, design.sums());
     if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
     BlockEvaluator evaluator(records[r], options.evaluation, w, std::get<WholeWindowValues>(whole));
+    BlockValues values(evaluator, records[r], w, nullptr);
     for (std::size_t e : g.equations) {
-      const ir::Equation& eq = model.equations[e];
       for (std::size_t start = 0; start < w.size(); start += block_rows) {
         const std::size_t m = std::min(block_rows, w.size() - start);
+        const auto count = static_cast<Eigen::Index>(m);
         evaluator.start_block(w.first + start, w.first + start + m);
         A.setZero();
-        for (const auto& term : eq.terms) {
-          const auto column = static_cast<Eigen::Index>(layout.column(term.parameter, r));
-          auto status = evaluator.evaluate(term.operation, std::span<double>(A.col(column).data(), m));
-          if (auto* d = std::get_if<Diagnostic>(&status)) return *d;
-        }
-        auto status = evaluator.evaluate(eq.known, std::span<double>(b.data(), m));
-        if (auto* d = std::get_if<Diagnostic>(&status)) return *d;
-        const Eigen::VectorXd residuals =
-            TriangularAccumulator::residuals_of(A.topRows(static_cast<Eigen::Index>(m)), b.head(static_cast<Eigen::Index>(m)), g.summary);
+        if (auto problem = design.equation_rows(r, e, values, {A.topRows(count), b.head(count)})) return problem;
+        const Eigen::VectorXd residuals = TriangularAccumulator::residuals_of(A.topRows(count), b.head(count), g.summary);
         block.clear();
         for (std::size_t i = 0; i < m; ++i)
           block.push_back({e, r, records[r].time[w.first + start + i], b(static_cast<Eigen::Index>(i)), residuals(static_cast<Eigen::Index>(i))});

@@ -5,8 +5,9 @@
 // equations that share no parameter are solved separately, equations that share parameters
 // jointly (one design matrix, rows stacked); each record contributes its own rows from its own fit
 // window, and, when there are several records, its own integration constants (named `C1@2` for
-// record 2). Every operation is evaluated on the window (evaluate.hpp); the summary carries the
-// least-squares statistics of each group and a report in the shape of the thesis' tables.
+// record 2). The design (its columns, rows and weights) comes from design.hpp, every operation
+// evaluated on the window; the summary carries the least-squares statistics of each group, each
+// column's model parameter beside its name, and a report in the shape of the thesis' tables.
 // Small groups are solved dense (the whole design, refinement against the rows, per-row
 // residuals); large ones are streamed (FitOptions::stream_above_entries): row blocks evaluated by
 // block_evaluator.hpp and folded into triangular_accumulator.hpp's factor on every core, in memory
@@ -25,6 +26,7 @@
 
 #include "ir/ir.hpp"
 #include "runtime/operators/evaluate.hpp"
+#include "runtime/solve/design.hpp"
 #include "runtime/solve/least_squares.hpp"
 
 namespace sidc {
@@ -64,6 +66,7 @@ struct Region {
 struct GroupFit {
   std::vector<std::size_t> equations;          // indices into the model's equations
   std::vector<std::string> columns;            // parameter names, integration constants per record
+  std::vector<ParameterIndex> column_parameters;  // beside columns: the model parameter (and record) of each
   std::vector<RecordRows> records;
   std::vector<Region> regions;  // empty when the equations have no guard
   bool weighted = false;        // rows weighted (eq. 2-1.6) by a record column and/or by the model's
@@ -106,10 +109,6 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
                                                   const FitOptions& options, const FitSummary& summary, std::size_t group,
                                                   const std::function<bool(std::span<const ResidualRow>)>& rows,
                                                   std::size_t max_rows = static_cast<std::size_t>(-1));
-
-// `set weights = <expression>` (eq. 2-1.6) on the evaluator's fit window: one weight per row, or
-// a Diagnostic at the `set weights` line when a value is negative, NaN or infinite.
-std::variant<std::vector<double>, Diagnostic> expression_weights(const ir::Model& model, Evaluator& evaluator);
 
 // Equations grouped so that two equations sharing a parameter are in one group (in order).
 std::vector<std::vector<std::size_t>> equation_groups(const ir::Model& model);

@@ -1,7 +1,7 @@
 // A fit's estimates laid out by another model's parameter order: the fit solves the integrated
 // model, while simulation, validation and pictures use the derivative form (its parameters are
-// the same names, without the integration constants), so the estimates are matched by name once,
-// here.
+// the same parameters first, then the integration constants), so the estimates are laid out once,
+// here, by the index each estimate carries.
 #pragma once
 
 #include <vector>

@@ -92,12 +92,22 @@ struct LeastSquaresOptions {
   bool is_valid(std::string* why) const;
 };
 
+// Which parameter of a model a column estimates (runtime/solve/design.hpp lays the columns out):
+// its index in the model's parameters and, for an integration constant fitted once per record,
+// that record. The solver itself sees names only; the design labels the estimates.
+struct ParameterIndex {
+  std::size_t parameter = 0;
+  std::optional<std::size_t> record;  // none: one value for every record
+  bool operator==(const ParameterIndex&) const = default;
+};
+
 struct ParameterEstimate {
   std::string name;
   double value = 0;           // 0 for a column dropped as dependent
   double standard_error = 0;  // NaN when not estimable (dependent column, or n == rank)
   double ci_low = 0;          // value -/+ t_{(1+level)/2, n-rank} * standard_error
   double ci_high = 0;
+  std::optional<ParameterIndex> index{};  // set when the columns are a model's (DesignBuilder::label)
 };
 
 struct LeastSquaresSummary {

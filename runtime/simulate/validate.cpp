@@ -85,11 +85,19 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     v.error.push_back(std::move(e));
   }
   if (v.simulation.completed()) {
-    std::string parts;
-    for (const auto& r : v.outputs)
-      parts += fmt::format("{}max |E[{}]| = {:.4g} at t = {:.4g} ({:.3g}% of max |{}|, eq. 4-1.5)", parts.empty() ? "" : "; ", r.output, r.max_abs_error,
-                           r.time_of_max, r.percent_error, r.output);
-    v.statement = "The fitted equations, solved from the record, follow it: " + parts + ".";
+    // The sentence follows from the numbers: "follow it" only when every output's fit % reaches
+    // kFollowsFitPercent; otherwise it names each output that falls short, where it departs most
+    // and by how much.
+    std::string parts, short_of;
+    for (const auto& r : v.outputs) {
+      const std::string numbers = fmt::format("max |E[{}]| = {:.4g} at t = {:.4g} ({:.3g}% of max |{}|, eq. 4-1.5)", r.output, r.max_abs_error,
+                                              r.time_of_max, r.percent_error, r.output);
+      parts += (parts.empty() ? "" : "; ") + numbers;
+      if (!(r.fit_percent >= kFollowsFitPercent))
+        short_of += fmt::format("{}fit {:.3g}% for {} (below {:g}%), {}", short_of.empty() ? "" : "; ", r.fit_percent, r.output, kFollowsFitPercent, numbers);
+    }
+    v.statement = short_of.empty() ? "The fitted equations, solved from the record, follow it: " + parts + "."
+                                   : "The fitted equations, solved from the record, do not follow it: " + short_of + ".";
   } else {
     v.statement = fmt::format("The fitted equations could not be solved over the whole record: {}. The model does not reproduce the record; "
                               "the numbers below cover the samples before t = {:.6g}.",

@@ -27,6 +27,14 @@
 
 namespace sidc {
 
+// The verdict's threshold: the fitted equations "follow" the record when, for every output, the
+// simulated output's error is at most a tenth of the output's own variation about its mean (fit %
+// = 100 (1 - ||y - yhat|| / ||y - mean(y)||) >= 90, MATLAB compare's measure). Below it the sentence
+// says "do not follow it" and names the output, the fit % and where it departs most. A noisy
+// record lowers fit % by its noise: at a noise of 1% of the output's spread the cost is about 1
+// point, so the threshold separates a wrong model from a noisy record.
+inline constexpr double kFollowsFitPercent = 90;
+
 struct ValidationOptions {
   SimulateOptions::Method method = SimulateOptions::Method::rk4;
   int substeps = 4;           // rk4, the thesis' solver: four steps per sample interval

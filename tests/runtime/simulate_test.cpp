@@ -268,6 +268,16 @@ TEST(Validate, ReproducesItsOwnRecordAndReportsDivergence) {
   const auto bad = std::get<ValidationSummary>(validate(m, f, wrong, record, v));
   EXPECT_GT(bad.outputs[0].max_abs_error, 10 * g.outputs[0].max_abs_error);
   EXPECT_NEAR(bad.outputs[0].percent_error, 100 * bad.outputs[0].max_abs_error / 1.8494, 0.5);
+  // The sentence follows from the numbers: the good fit follows the record, and a model whose
+  // fit % falls below the threshold is said not to, with its fit % and where it departs most.
+  EXPECT_NE(g.statement.find("follow it:"), std::string::npos) << g.statement;
+  std::vector<double> far = kThesisParameters;
+  far[0] *= 3;  // three times the mass: the free run no longer keeps up with the forcing
+  const auto off = std::get<ValidationSummary>(validate(m, f, far, record, v));
+  ASSERT_TRUE(off.simulation.completed());
+  ASSERT_LT(off.outputs[0].fit_percent, kFollowsFitPercent);
+  EXPECT_NE(off.statement.find("do not follow it: fit "), std::string::npos) << off.statement;
+  EXPECT_NE(off.statement.find("for y (below 90%)"), std::string::npos) << off.statement;
   // A negative spring makes the solution run away: a statement, not an error.
   std::vector<double> unstable = kThesisParameters;
   unstable[5] = -3000;

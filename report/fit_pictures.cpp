@@ -10,6 +10,7 @@
 
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
 #include "report/html_report.hpp"
@@ -84,12 +85,9 @@ std::optional<std::vector<double>> exact_column(const Record& r, const ir::DataS
 // The highest derivative of `signal` written in the sum (guards, functions and integrals included).
 int order_of(const ir::Sum& s, const std::string& signal) {
   int order = -1;
-  for (const auto& t : s.terms)
-    for (const auto& [f, power] : t.factors) {
-      if (f.kind == ir::FactorKind::signal && f.name == signal) order = std::max(order, f.order);
-      if (f.argument) order = std::max(order, order_of(*f.argument, signal));
-      for (const auto& c : f.conditions) order = std::max({order, order_of(*c.lhs, signal), order_of(*c.rhs, signal)});
-    }
+  ir::for_each_factor(s, [&](const ir::Factor& f) {
+    if (f.kind == ir::FactorKind::signal && f.name == signal) order = std::max(order, f.order);
+  });
   return order;
 }
 

@@ -51,6 +51,7 @@
 #include "runtime/operators/evaluate.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/least_squares.hpp"
+#include "runtime/solve/options_from_settings.hpp"
 #include "runtime/records/records.hpp"
 
 #ifndef SIDC_BINARY
@@ -313,15 +314,9 @@ struct PathTotals {
   bool complete = false;
 };
 
+// The model's settings read as `sidc fit` reads them (runtime/solve/options_from_settings.hpp).
 sidc::EvaluationOptions evaluation_options(const sidc::ir::Model& model) {
-  const sidc::EvaluationSettings e = sidc::evaluation_settings(model.settings);
-  sidc::EvaluationOptions o;
-  o.derivative.window = e.derivative.window;
-  o.derivative.polyorder = e.derivative.order;
-  o.derivative.second = e.second_derivative_repeated ? sidc::DerivativeOptions::Second::repeated : sidc::DerivativeOptions::Second::direct;
-  o.derivative.edges = e.shorten_edges ? sidc::DerivativeOptions::Edges::shorten : sidc::DerivativeOptions::Edges::drop;
-  o.integration.rule = e.trapezoid ? sidc::IntegrationOptions::Rule::trapezoid : sidc::IntegrationOptions::Rule::simpson;
-  return o;
+  return sidc::evaluation_options(sidc::evaluation_settings(model.settings));
 }
 
 void print_estimates(const sidc::LeastSquaresSummary& s) {

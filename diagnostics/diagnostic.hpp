@@ -6,11 +6,13 @@
 //   hint: did you mean `y`?
 //
 // Data files use the same shape with row and column (`data.csv:17:3: error: ...`). Wording lives
-// in diagnostic_catalogue.hpp; passes build Diagnostics only through it.
+// in the catalogues (model_catalogue.hpp, data_catalogue.hpp, cli_catalogue.hpp); passes build
+// Diagnostics only through them.
 #pragma once
 
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "diagnostics/source.hpp"
@@ -42,6 +44,12 @@ struct Diagnostics {
   bool has_errors() const;
   std::string render_all() const;
 };
+
+// A whole text file (a model, a compiled model, a fit's parameters), or the Diagnostic naming the
+// file and why it cannot be read (diagnostics/cli_catalogue.hpp).
+std::variant<std::string, Diagnostic> read_text_file(const std::string& path);
+// The same, with the Diagnostic rendered into `error`.
+std::optional<std::string> read_whole_file(const std::string& path, std::string& error);
 
 namespace diag {
 // An error at `where` with a stable `code`: the one constructor the catalogues build on.

@@ -7,10 +7,8 @@
 
 #include <cstddef>
 #include <memory>
-#include <optional>
 #include <string>
 #include <string_view>
-#include <variant>
 #include <vector>
 
 namespace sidc {
@@ -41,13 +39,5 @@ struct Span {
   SourceFile::Position start() const { return file ? file->position(begin) : SourceFile::Position{0, 0}; }
   std::size_t length() const { return end > begin ? end - begin : 0; }
 };
-
-struct Diagnostic;
-
-// A whole text file (a model, a compiled model, a fit's parameters), or the Diagnostic naming the
-// file and why it cannot be read (diagnostics/cli_catalogue.hpp).
-std::variant<std::string, Diagnostic> read_text_file(const std::string& path);
-// The same, with the Diagnostic rendered into `error`.
-std::optional<std::string> read_whole_file(const std::string& path, std::string& error);
 
 }  // namespace sidc

@@ -15,6 +15,16 @@
 namespace sidc {
 namespace {
 
+// The umask cannot be read without setting it; read it once, before any thread writes files.
+mode_t process_umask() {
+  static const mode_t mask = [] {
+    const mode_t m = ::umask(0);
+    ::umask(m);
+    return m;
+  }();
+  return mask;
+}
+
 bool fail(std::string* why, const std::string& destination, const std::string& reason) {
   if (why) *why = "cannot write `" + destination + "`: " + reason;
   return false;
@@ -33,8 +43,9 @@ std::string create_temporary_beside(const std::string& destination, std::string*
     fail(why, destination, std::strerror(errno));
     return "";
   }
-  // mkstemp makes the file private (0600); a model, a picture or a report is meant to be read by others.
-  ::fchmod(fd, 0644);
+  // mkstemp makes the file private (0600); give it the mode a newly created file gets here
+  // (0666 less the umask), as any other program's output would have.
+  ::fchmod(fd, 0666 & ~process_umask());
   ::close(fd);
   return std::string(buffer.data());
 }
@@ -52,14 +63,20 @@ bool write_file_atomically(const std::string& destination, const std::function<b
   const std::string temporary = create_temporary_beside(destination, why);
   if (temporary.empty()) return false;
   bool ok = false;
-  {
+  int error = 0;
+  try {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     ok = out && write(out) && out.flush();
+    out.close();  // a failure reported only at close (a full disk, NFS) must not be renamed into place
+    ok = ok && !out.fail();
+    error = errno;
+  } catch (...) {  // the writer threw: nothing half-written may stay behind
+    ok = false;
+    error = EIO;
   }
   if (!ok) {
-    const int error = errno;
     std::remove(temporary.c_str());
-    return fail(why, destination, std::strerror(error));
+    return fail(why, destination, std::strerror(error ? error : EIO));
   }
   return replace_file(temporary, destination, why);
 }

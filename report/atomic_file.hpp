@@ -15,8 +15,8 @@
 
 namespace sidc {
 
-// Creates an empty, uniquely named file `DIR/.STEM.XXXXXX` beside `destination` (mode 0644) and
-// returns its path, or "" with *why set.
+// Creates an empty, uniquely named file `DIR/.STEM.XXXXXX` beside `destination` (mode 0666 less
+// the umask, as a newly created file) and returns its path, or "" with *why set.
 std::string create_temporary_beside(const std::string& destination, std::string* why);
 
 // Renames `temporary` over `destination`; on failure removes `temporary`.

@@ -22,19 +22,9 @@
 #include "runtime/operators/savitzky_golay.hpp"
 #include "runtime/operators/signal_operator.hpp"
 #include "runtime/operators/simpson.hpp"
+#include "runtime/records/sampled_record.hpp"
 
 namespace sidc {
-
-// One record's signals on one uniform time grid.
-struct SampledRecord {
-  std::string path;                                    // for messages
-  double step = 0;
-  std::vector<double> time;                            // absolute times, time[k] = time[0] + k*step
-  std::map<std::string, std::vector<double>> signals;  // by signal name
-  std::map<std::string, std::string> columns;          // signal -> the column it came from (for messages)
-  std::vector<double> weights;                         // eq. 2-1.6: per sample; empty = all 1
-  std::string weights_column;
-};
 
 // What chooses and configures the operators (derivative_operator(), integral_operator()).
 struct EvaluationOptions {

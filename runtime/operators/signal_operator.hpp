@@ -16,8 +16,9 @@
 //      (simpson.hpp) do; list the .cpp in runtime/CMakeLists.txt.
 //   2. Register it: a field in EvaluationOptions that selects it, and a branch on that field in
 //      derivative_operator() or integral_operator() (signal_operator.cpp). No evaluator changes.
-//      For users to choose it, the field also needs its setting (ir/settings.cpp) and its flag
-//      (cli/record_options.cpp), as `derivative = savgol(7, 3)` and `--derivative` have.
+//      For users to choose it, the field also needs its setting (ir/settings.cpp), its translation
+//      (runtime/solve/options_from_settings.cpp) and its flag (cli/record_options.cpp), as
+//      `derivative = savgol(7, 3)` and `--derivative` have.
 #pragma once
 
 #include <cstddef>

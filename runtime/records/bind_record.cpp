@@ -4,6 +4,7 @@
 #include <map>
 
 #include "ir/queries.hpp"
+#include "runtime/operators/evaluate.hpp"  // inputs defined by an expression of t, evaluated on the grid
 
 namespace sidc {
 namespace {

@@ -12,8 +12,8 @@
 #include <variant>
 
 #include "ir/ir.hpp"
-#include "runtime/operators/evaluate.hpp"
 #include "runtime/records/records.hpp"
+#include "runtime/records/sampled_record.hpp"
 #include "runtime/records/sampling.hpp"
 
 namespace sidc {

@@ -4,6 +4,8 @@
 #include <limits>
 #include <fmt/format.h>
 
+#include "runtime/solve/fitted_values.hpp"
+
 namespace sidc {
 
 std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,

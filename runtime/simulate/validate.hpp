@@ -22,7 +22,7 @@
 
 #include "ir/explicit_form.hpp"
 #include "runtime/operators/evaluate.hpp"
-#include "runtime/solve/fitted_values.hpp"
+#include "runtime/solve/fit.hpp"
 #include "runtime/simulate/simulate.hpp"
 
 namespace sidc {

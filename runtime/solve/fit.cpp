@@ -499,7 +499,7 @@ std::string FitSummary::full_report(const ir::Model& model) const {
     out += fmt::format("  condition {:.3g} before scaling, {:.3g} after (section 3-2); about {:.1f} digits lost\n", s.condition_before,
                        s.condition_after, s.digits_lost_estimate);
     out += fmt::format("  arithmetic: {}\n", s.arithmetic);
-    if (!g.streamed.empty()) out += fmt::format("  solved: {} (runtime/solve/fit.hpp: FitOptions::stream_above_entries)\n", g.streamed);
+    if (!g.streamed.empty()) out += fmt::format("  solved: {} (its design exceeds FitOptions::stream_above_entries)\n", g.streamed);
     // Double precision carries about 16 digits; the scaled condition number says how many survive.
     if (const double left = 16 - s.digits_lost_estimate; s.is_solution_usable() && left < 4)
       out += fmt::format("  WARNING: only about {:.0f} correct digit{} can be expected in the estimates (condition {:.3g} after scaling)\n",

@@ -11,8 +11,11 @@ Data flows one way: diagnostics/ and ir/ at the bottom, grammar/ -> compiler/ ->
 report/ -> cli/. A folder may include its own headers and those of the layers it lists below;
 everything outside the layers (tests/, bench/, examples/) may include any layer but cli/.
 Includes are read as the project writes them, by paths relative to the repository root
-(`#include "runtime/solve/fit.hpp"`); a path relative to the including file (`"../ir/ir.hpp"`)
-is resolved first. Only the first folder of the path matters.
+(`#include "runtime/solve/fit.hpp"`). Every path is normalised first (`a/../b`); a quoted path
+is resolved against the including file's folder when a file of that name is there (`"../ir/ir.hpp"`,
+`"solve/../../compiler/x.hpp"`), else against the repository root. The folder the normalised path
+starts with is the layer it names. Every folder of the repository is scanned except build trees
+and hidden ones: one that is not a layer counts as outside the layers.
 """
 import os
 import re
@@ -31,27 +34,32 @@ ALLOWED = {
     "report": {"runtime", "ir", "diagnostics"},
     "cli": {"report", "runtime", "compiler", "grammar", "ir", "diagnostics"},
 }
-OUTSIDE = ["tests", "bench", "examples"]  # may include any layer but cli/
-SOURCE_SUFFIXES = (".hpp", ".cpp", ".h", ".hh", ".cc", ".ipp")
+SOURCE_SUFFIXES = (".hpp", ".cpp", ".h", ".hh", ".cc", ".cxx", ".hxx", ".ipp", ".inl", ".tpp")
 INCLUDE = re.compile(r'^\s*#\s*include\s*(["<])([^">]+)[">]')
 
 
 def included_layer(root, including_file, quote, path):
     """The layer folder an include names, or None when it is not one of sidc's."""
-    if quote == '"' and path.startswith("."):  # relative to the including file
-        resolved = os.path.normpath(os.path.join(os.path.dirname(including_file), path))
-        path = os.path.relpath(resolved, root).replace(os.sep, "/")
+    beside = os.path.normpath(os.path.join(os.path.dirname(including_file), path))
+    if quote == '"' and (path.startswith(".") or os.path.exists(beside)):  # relative to the includer
+        path = os.path.relpath(beside, root)
+    else:
+        path = os.path.normpath(path)
+    path = path.replace(os.sep, "/")
     first = path.split("/", 1)[0]
     return first if "/" in path and first in LAYERS else None
 
 
 def source_files(root):
-    for top in LAYERS + OUTSIDE:
-        for folder, dirs, files in os.walk(os.path.join(root, top)):
-            dirs.sort()
-            for name in sorted(files):
-                if name.endswith(SOURCE_SUFFIXES):
-                    yield top, os.path.join(folder, name)
+    """(top folder, path) of every source file, build trees and hidden folders left out."""
+    for folder, dirs, files in os.walk(root):
+        relative = os.path.relpath(folder, root)
+        dirs[:] = sorted(d for d in dirs if not d.startswith(".") and not d.startswith("build")
+                         and not (relative == "." and d == "Testing"))
+        top = relative.split(os.sep, 1)[0] if relative != "." else ""
+        for name in sorted(files):
+            if name.endswith(SOURCE_SUFFIXES):
+                yield top, os.path.join(folder, name)
 
 
 def violations(root):
@@ -70,7 +78,7 @@ def violations(root):
                     continue
                 allowed = ALLOWED[top] if top in ALLOWED else set(LAYERS) - {"cli"}
                 if layer not in allowed:
-                    where = top + "/" if top in ALLOWED else "code outside the layers (" + top + "/)"
+                    where = top + "/" if top in ALLOWED else "code outside the layers (" + (top or ".") + "/)"
                     found.append((os.path.relpath(path, root), number,
                                   f"{where} may not include {layer}/: {line.strip()}"))
     return found, scanned
@@ -106,6 +114,10 @@ PLANTS = [
     ("compiler/planted_cli.cpp", "cli/read_file.hpp"),
     ("tests/runtime/planted_test.cpp", "cli/record_options.hpp"),
     ("runtime/operators/planted_relative.cpp", "../../compiler/pipeline.hpp"),
+    ("runtime/solve/planted_dotdot.cpp", "runtime/../compiler/pipeline.hpp"),
+    ("runtime/solve/planted_beside.cpp", "../../compiler/../compiler/pipeline.hpp"),
+    ("plugins/planted.cpp", "cli/exit_codes.hpp"),
+    ("report/planted.inl", "grammar/ast.hpp"),
 ]
 # Includes that are allowed, planted too: none may be reported.
 ALLOWED_PLANTS = [
@@ -136,12 +148,10 @@ def plant(copy, relative, include):
 def self_test(root):
     problems = []
     with tempfile.TemporaryDirectory(prefix="sidc-layers-") as copy:
-        for top in LAYERS + OUTSIDE:
-            source = os.path.join(root, top)
-            if os.path.isdir(source):
-                shutil.copytree(source, os.path.join(copy, top),
-                                ignore=lambda folder, names: [n for n in names if os.path.isfile(os.path.join(folder, n))
-                                                              and not n.endswith(SOURCE_SUFFIXES)])
+        for _, path in source_files(root):
+            target = os.path.join(copy, os.path.relpath(path, root))
+            os.makedirs(os.path.dirname(target), exist_ok=True)
+            shutil.copyfile(path, target)
         found, _ = violations(copy)
         if found:
             problems.append(f"the unchanged copy already has {len(found)} forbidden include(s)")

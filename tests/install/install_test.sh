@@ -4,7 +4,10 @@
 # run on the thesis' section 4-1 model, whose estimates it must print (tests/install/CMakeLists.txt).
 #
 #   install_test.sh build=DIR source=DIR cmake=PATH generator=NAME make=PATH cxx=PATH
-#                   build_type=TYPE cxx_flags=FLAGS sanitize=ON|OFF
+#                   build_type=TYPE cxx_flags=FLAGS sanitize=ON|OFF [prefix_path=LIST]
+#
+# prefix_path: the build's own CMAKE_PREFIX_PATH, searched after the fresh prefix, so that the
+# package's dependencies (Eigen, fmt, Boost, nlohmann_json) are found where sidc's build found them.
 #
 # Everything it makes lies in one temporary folder, removed when it ends.
 set -euo pipefail
@@ -13,7 +16,8 @@ declare -A arg
 for a in "$@"; do arg[${a%%=*}]=${a#*=}; done
 build=${arg[build]} source=${arg[source]} cmake=${arg[cmake]}
 
-work=$(mktemp -d "${TMPDIR:-/tmp}/sidc-install-test.XXXXXX")
+# The physical path, as CMake stores it (no `//` from a TMPDIR ending in `/`, no symlink).
+work=$(cd "$(mktemp -d "${TMPDIR:-/tmp}/sidc-install-test.XXXXXX")" && pwd -P)
 trap 'rm -rf "$work"' EXIT
 prefix=$work/prefix
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -53,7 +57,7 @@ linker_flags=""
   -DCMAKE_MAKE_PROGRAM="${arg[make]}" -DCMAKE_CXX_COMPILER="${arg[cxx]}" \
   -DCMAKE_BUILD_TYPE="${arg[build_type]:-}" -DCMAKE_CXX_FLAGS="${arg[cxx_flags]:-}" \
   -DCMAKE_EXE_LINKER_FLAGS="$linker_flags" \
-  -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
+  -DCMAKE_PREFIX_PATH="$prefix${arg[prefix_path]:+;${arg[prefix_path]}}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
   > "$work/configure.log" 2>&1 || { cat "$work/configure.log"; fail "configuring examples/library failed"; }
 found=$(sed -n 's/^sidc_DIR:PATH=//p' "$work/build/CMakeCache.txt")
 [[ $found == "$package" ]] || fail "find_package(sidc) found $found, not the package just installed in $package"

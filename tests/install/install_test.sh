@@ -51,11 +51,17 @@ fi
 
 step "configuring examples/library against $prefix"
 linker_flags=""
-# A sanitized sidc's libraries need the sanitizers' runtime, which the package does not impose.
-[[ ${arg[sanitize]:-OFF} == ON ]] && linker_flags="-fsanitize=address,undefined"
+cxx_flags=${arg[cxx_flags]:-}
+# A sanitized sidc's libraries need the sanitizers' runtime, which the package does not impose, and
+# the consumer compiled alike: Eigen's inline allocation code differs with and without ASan, and two
+# versions of it in one program free what the other allocated.
+if [[ ${arg[sanitize]:-OFF} == ON ]]; then
+  linker_flags="-fsanitize=address,undefined"
+  cxx_flags="$cxx_flags -fsanitize=address,undefined -fno-omit-frame-pointer"
+fi
 "$cmake" -S "$source/examples/library" -B "$work/build" -G "${arg[generator]}" \
   -DCMAKE_MAKE_PROGRAM="${arg[make]}" -DCMAKE_CXX_COMPILER="${arg[cxx]}" \
-  -DCMAKE_BUILD_TYPE="${arg[build_type]:-}" -DCMAKE_CXX_FLAGS="${arg[cxx_flags]:-}" \
+  -DCMAKE_BUILD_TYPE="${arg[build_type]:-}" -DCMAKE_CXX_FLAGS="$cxx_flags" \
   -DCMAKE_EXE_LINKER_FLAGS="$linker_flags" \
   -DCMAKE_PREFIX_PATH="$prefix${arg[prefix_path]:+;${arg[prefix_path]}}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
   > "$work/configure.log" 2>&1 || { cat "$work/configure.log"; fail "configuring examples/library failed"; }

@@ -39,11 +39,6 @@ struct FitArguments {
   std::string report;                 // --report FILE.html
 };
 
-int fail(const std::string& message, int code) {
-  std::cerr << message << "\n";
-  return code;
-}
-
 // The compiled model to fit when none is named: the most recently compiled *.sidc.json in the
 // current directory, so that `sidc compile model.sid && sidc fit` fits that model.
 std::optional<std::string> default_compiled_model() {

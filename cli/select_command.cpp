@@ -25,11 +25,6 @@
 namespace sidc {
 namespace {
 
-int fail(const std::string& message, int code) {
-  std::cerr << message << "\n";
-  return code;
-}
-
 struct SelectArguments {
   std::string model;
   RecordArguments records;  // as sidc fit: --data, --from, --to, --every, ... (record_options.hpp)

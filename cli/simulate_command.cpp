@@ -135,10 +135,6 @@ std::variant<std::map<std::string, std::vector<std::optional<double>>>, Failure>
 }
 
 int run_simulate(const SimulateArguments& a) {
-  auto fail = [](const std::string& message, int code) {
-    std::cerr << message << "\n";
-    return code;
-  };
   if (a.t0 && a.t1 && !(*a.t1 > *a.t0)) return fail(render(cli_diag::end_not_after_start(*a.t1, *a.t0)), exit_code::usage_error);
   std::string error, warnings;
   auto compiled = load_compiled_model(a.model, error, warnings);

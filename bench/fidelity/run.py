@@ -1,0 +1,338 @@
+#!/usr/bin/env python3
+"""The fidelity benchmark (issue 13, item 7): does sidc get known parameters back from noisy records?
+
+For every system of systems.py, noise level and seed, and every configuration, it writes the case
+(records.py), then runs
+
+  1. `sidc fit model.sid --out fit` (the true terms, parameters free): the largest relative
+     parameter error against the truth, and the validation verdict of fit.json;
+  2. `sidc simulate` of the fitted parameters from the true initial state against the noise-free
+     record: the truth about whether the fitted model "follows" (fit % >= 90 for every output,
+     the threshold sidc's own verdict uses), which the verdict should agree with;
+  3. `sidc select library.sid --out sel`: is the chosen subset exactly the true term set?
+
+and prints one Markdown table per configuration, and writes every run to results.csv and
+results.json. A failing sidc (non-zero exit, timeout, missing output) is recorded as such and the
+run goes on. See README.md for the definitions and the command line.
+"""
+
+import argparse
+import concurrent.futures
+import json
+import math
+import os
+import shlex
+import statistics
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import records  # noqa: E402
+from systems import BY_NAME, SYSTEMS  # noqa: E402
+
+FOLLOWS_FIT_PERCENT = 90.0   # as kFollowsFitPercent in runtime/simulate/validate.hpp
+NOISE_LEVELS = [0.0, 0.001, 0.01, 0.05]
+QUICK_LEVELS = [0.001, 0.01]
+
+
+class Config:
+    """A named configuration: `set` lines inserted into the models, options for fit and select.
+
+    ARGS is split at `;` into parts: `set KEY = VALUE` goes into both models (before the
+    equations, so `set integrate` applies to them); `fit: OPTIONS` goes to `sidc fit` only,
+    `select: OPTIONS` to `sidc select` only; anything else is options for both.
+    """
+
+    def __init__(self, name, args=""):
+        self.name, self.args = name, args
+        self.set_lines, self.fit_options, self.select_options = [], [], []
+        for part in (p.strip() for p in args.split(";")):
+            if not part:
+                continue
+            if part.startswith("set "):
+                self.set_lines.append(part)
+            elif part.startswith("fit:"):
+                self.fit_options += shlex.split(part[4:])
+            elif part.startswith("select:"):
+                self.select_options += shlex.split(part[7:])
+            else:
+                opts = shlex.split(part)
+                self.fit_options += opts
+                self.select_options += opts
+
+    def apply(self, model_text):
+        return model_text.replace(records.SETTINGS_MARKER, "\n".join([records.SETTINGS_MARKER] + self.set_lines))
+
+
+def run(cmd, cwd, timeout):
+    start = time.monotonic()
+    try:
+        p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout)
+        rc, err = p.returncode, p.stderr
+    except subprocess.TimeoutExpired:
+        rc, err = "timeout", f"timed out after {timeout} s"
+    except OSError as e:
+        rc, err = "not run", str(e)
+    return rc, err.strip().splitlines()[-1] if err.strip() else "", time.monotonic() - start
+
+
+def read_csv(path):
+    with open(path) as f:
+        names = f.readline().strip().split(",")
+        cols = {n: [] for n in names}
+        for line in f:
+            for n, v in zip(names, line.strip().split(",")):
+                cols[n].append(float(v))
+    return cols
+
+
+def fit_percent(reference, simulated):
+    """MATLAB compare's fit: 100 (1 - ||y - yhat|| / ||y - mean(y)||); NaN if the run stopped."""
+    if len(simulated) != len(reference) or any(not math.isfinite(v) for v in simulated):
+        return float("nan")
+    mean = sum(reference) / len(reference)
+    e = math.sqrt(sum((a - b) ** 2 for a, b in zip(reference, simulated)))
+    d = math.sqrt(sum((a - mean) ** 2 for a in reference))
+    return 100 * (1 - e / d) if d > 0 else float("nan")
+
+
+def verdict_of(fit):
+    """'follows' / 'does not follow' from fit.json's validation, None when there is none."""
+    v = fit.get("validation") or {}
+    recs = v.get("records") or []
+    if not recs:
+        return None
+    for r in recs:
+        if not r.get("completed") or "do not follow" in r.get("statement", "") or "follow it" not in r.get("statement", ""):
+            return "does not follow"
+    return "follows"
+
+
+def run_case(sidc, work, config, system, level, seed, timeout):
+    d = os.path.join(work, config.name, system.name, f"noise{level:g}_s{seed}")
+    truth = records.write_case(d, system, level, seed)
+    base_model = open(os.path.join(d, "model.sid")).read()
+    with open(os.path.join(d, "truth_model.sid"), "w") as f:
+        f.write(base_model)
+    for name in ("model.sid", "library.sid"):
+        path = os.path.join(d, name)
+        text = open(path).read()
+        with open(path, "w") as f:
+            f.write(config.apply(text))
+
+    row = {"config": config.name, "system": system.name, "noise": level, "seed": seed,
+           "fit_exit": None, "fit_error": "", "max_rel_error": None, "worst_parameter": None,
+           "estimates": {}, "verdict": None, "validation_fit_percent": None,
+           "truth_fit_percent": None, "truth_follows": None, "verdict_agrees": None,
+           "select_exit": None, "select_error": "", "selected": None, "select_recovered": None,
+           "seconds": 0.0}
+
+    # 1. the fit of the true terms
+    rc, err, secs = run([sidc, "fit", "model.sid", "--out", "fit"] + config.fit_options, d, timeout)
+    row["fit_exit"], row["seconds"] = rc, secs
+    fit = None
+    fit_path = os.path.join(d, "fit", "fit.json")
+    if rc == 0 and os.path.exists(fit_path):
+        fit = json.load(open(fit_path))
+        est = {p["name"]: p["estimate"] for g in fit.get("groups", []) for p in g.get("parameters", [])}
+        row["estimates"] = {k: est.get(k) for k in system.truth}
+        errors = {k: abs(est[k] - v) / abs(v) if est.get(k) is not None else math.inf for k, v in system.truth.items()}
+        worst = max(errors, key=errors.get)
+        row["max_rel_error"], row["worst_parameter"] = errors[worst], worst
+        row["verdict"] = verdict_of(fit)
+        outs = [o.get("fit_percent") for r in (fit.get("validation") or {}).get("records", []) for o in r.get("outputs", [])]
+        outs = [o if o is not None else float("nan") for o in outs]
+        row["validation_fit_percent"] = min(outs) if outs else None
+    else:
+        row["fit_error"] = err or "fit.json missing"
+
+    # 2. the truth: the fitted parameters simulated from the true initial state, against the noise-free record
+    if fit is not None:
+        initial = [f"{k}={v!r}" for k, v in truth["initial_state"].items()]
+        rc, err, s2 = run([sidc, "simulate", "truth_model.sid", "--params", "fit/fit.json", "--data", "truth.csv",
+                           "--substeps", "10", "-o", "truth_sim.csv", "--initial"] + initial, d, timeout)
+        row["seconds"] += s2
+        reference = read_csv(os.path.join(d, "truth.csv"))
+        percents = []
+        sim_path = os.path.join(d, "truth_sim.csv")
+        sim = read_csv(sim_path) if os.path.exists(sim_path) else {}
+        for out in system.outputs:
+            percents.append(fit_percent(reference[out], sim.get(out, [])) if rc == 0 else float("nan"))
+        worst = min(percents, key=lambda p: p if math.isfinite(p) else -math.inf)
+        row["truth_fit_percent"] = worst
+        row["truth_follows"] = bool(math.isfinite(worst) and worst >= FOLLOWS_FIT_PERCENT)
+        if row["verdict"] is not None:
+            row["verdict_agrees"] = (row["verdict"] == "follows") == row["truth_follows"]
+
+    # 3. the selection over the candidate library
+    rc, err, s3 = run([sidc, "select", "library.sid", "--out", "sel"] + config.select_options, d, timeout)
+    row["select_exit"], row["seconds"] = rc, row["seconds"] + s3
+    sel_path = os.path.join(d, "sel", "select.json")
+    if rc == 0 and os.path.exists(sel_path):
+        sel = json.load(open(sel_path))
+        chosen = set()
+        for g in sel.get("groups", []):
+            sizes = {s["size"]: s for s in g.get("sizes", [])}
+            best = sizes.get(g.get("chosen_size"))
+            if best is not None:
+                chosen |= set(best.get("parameters", {}))
+        true_set = set().union(*system.library_truth.values())
+        row["selected"] = sorted(chosen)
+        row["select_recovered"] = chosen == true_set
+    else:
+        row["select_error"] = err or "select.json missing"
+    return row
+
+
+# ---------------------------------------------------------------------------------------- output
+
+def pct(e):
+    if e is None:
+        return "fail"
+    if not math.isfinite(e):
+        return "inf"
+    v = 100 * e
+    return f"{v:.0f}%" if v >= 100 else f"{v:.2g}%"
+
+
+def error_cell(rows):
+    errs = [r["max_rel_error"] for r in rows]
+    ok = [e for e in errs if e is not None]
+    if not ok:
+        return "fail"
+    med = statistics.median(ok)
+    worst = "fail" if len(ok) < len(errs) else pct(max(ok))
+    return pct(med) if len(rows) == 1 else f"{pct(med)} ({worst})"
+
+
+def count_cell(rows, key):
+    good = sum(1 for r in rows if r[key] is True)
+    return f"{good}/{len(rows)}"
+
+
+def tables(rows, configs, systems, levels):
+    out = []
+    for c in configs:
+        mine = [r for r in rows if r["config"] == c.name]
+        if not mine:
+            continue
+        out.append(f"### Configuration `{c.name}`" + (f": `{c.args}`" if c.args else " (sidc's defaults)"))
+        out.append("")
+        out.append("Largest relative parameter error, median over seeds (worst in parentheses); "
+                   "then verdict agreement · exact term recovery by `sidc select`.")
+        out.append("")
+        head = "| system | " + " | ".join(f"noise {100 * lv:g}%" for lv in levels) + " |"
+        out.append(head)
+        out.append("| --- |" + " ---: |" * len(levels))
+        for s in systems:
+            cells = []
+            for lv in levels:
+                rs = [r for r in mine if r["system"] == s.name and r["noise"] == lv]
+                cells.append(f"{error_cell(rs)}<br>{count_cell(rs, 'verdict_agrees')} · {count_cell(rs, 'select_recovered')}" if rs else "")
+            out.append(f"| {s.name} | " + " | ".join(cells) + " |")
+        n = len(mine)
+        fails = sum(1 for r in mine if r["fit_exit"] != 0)
+        sfails = sum(1 for r in mine if r["select_exit"] != 0)
+        agree = sum(1 for r in mine if r["verdict_agrees"] is True)
+        low = [r for r in mine if r["noise"] <= 0.01]
+        rec = sum(1 for r in low if r["select_recovered"] is True)
+        out.append("")
+        out.append(f"{n} cases: `sidc fit` failed in {fails}, `sidc select` in {sfails}; the verdict agreed with "
+                   f"the truth in {agree} of {n}; `sidc select` recovered the exact true set in {rec} of "
+                   f"{len(low)} cases at noise up to 1%.")
+        out.append("")
+    return "\n".join(out)
+
+
+CSV_FIELDS = ["config", "system", "noise", "seed", "fit_exit", "max_rel_error", "worst_parameter", "verdict",
+              "validation_fit_percent", "truth_fit_percent", "truth_follows", "verdict_agrees", "select_exit",
+              "selected", "select_recovered", "seconds", "fit_error", "select_error", "estimates"]
+
+
+def write_results(out_dir, rows, markdown):
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, "results.json"), "w") as f:
+        json.dump(rows, f, indent=1, default=str)
+    with open(os.path.join(out_dir, "results.csv"), "w") as f:
+        f.write(",".join(CSV_FIELDS) + "\n")
+        for r in rows:
+            vals = []
+            for k in CSV_FIELDS:
+                v = r[k]
+                if isinstance(v, (dict, list)):
+                    v = json.dumps(v, separators=(";", "="))
+                vals.append('"' + str("" if v is None else v).replace('"', "'") + '"')
+            f.write(",".join(vals) + "\n")
+    with open(os.path.join(out_dir, "tables.md"), "w") as f:
+        f.write(markdown + "\n")
+
+
+def main():
+    p = argparse.ArgumentParser(description="The fidelity benchmark of sidc (bench/fidelity/README.md).")
+    p.add_argument("--sidc", default="build/cli/sidc", help="the sidc binary (default build/cli/sidc)")
+    p.add_argument("--config", action="append", default=[], metavar="NAME=ARGS",
+                   help="an extra configuration (repeatable): `set` lines and/or options, parts separated by `;`")
+    p.add_argument("--no-default", action="store_true", help="leave out the default configuration")
+    p.add_argument("--quick", action="store_true", help="one seed, noise 0.1%% and 1%% only")
+    p.add_argument("--system", action="append", help="only this system (repeatable)")
+    p.add_argument("--noise", action="append", type=float, help="only this noise level, a fraction (repeatable)")
+    p.add_argument("--seeds", type=int, default=3, help="seeds per noisy level (default 3; noise 0 uses one)")
+    p.add_argument("-j", "--jobs", type=int, default=2, help="cases run at once (default 2)")
+    p.add_argument("--work", default="/tmp/sidc-fidelity", help="where the cases are written (default /tmp/sidc-fidelity)")
+    p.add_argument("--out", help="where results.csv, results.json and tables.md go (default: WORK)")
+    p.add_argument("--timeout", type=float, default=600, help="seconds per sidc command (default 600)")
+    a = p.parse_args()
+
+    sidc = os.path.abspath(a.sidc)
+    if not os.access(sidc, os.X_OK):
+        p.error(f"no sidc binary at {a.sidc}; build it (cmake --build build --target sidc) or pass --sidc PATH")
+    configs = [] if a.no_default else [Config("default")]
+    for spec in a.config:
+        name, _, args = spec.partition("=")
+        if not name or not name.replace("_", "").replace("-", "").isalnum():
+            p.error(f"--config {spec!r}: expected NAME=ARGS with a plain NAME")
+        configs.append(Config(name, args))
+    if not configs:
+        p.error("no configuration to run")
+    systems = [BY_NAME[n] for n in a.system] if a.system else SYSTEMS
+    levels = a.noise or (QUICK_LEVELS if a.quick else NOISE_LEVELS)
+    seeds = 1 if a.quick else a.seeds
+
+    # Noise-free records first (one solve per system, shared by every case).
+    for s in systems:
+        records.noise_free(s)
+
+    jobs = [(c, s, lv, k) for c in configs for s in systems for lv in levels
+            for k in range(1, (1 if lv == 0 else seeds) + 1)]
+    print(f"fidelity: {len(jobs)} cases ({len(configs)} configuration(s) x {len(systems)} systems), "
+          f"-j {a.jobs}, sidc = {sidc}", file=sys.stderr)
+    rows = []
+    start = time.monotonic()
+    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
+        futures = {pool.submit(run_case, sidc, a.work, c, s, lv, k, a.timeout): (c, s, lv, k) for c, s, lv, k in jobs}
+        for fut in concurrent.futures.as_completed(futures):
+            c, s, lv, k = futures[fut]
+            try:
+                row = fut.result()
+            except Exception as e:  # a bug here must not lose the other cases
+                row = {"config": c.name, "system": s.name, "noise": lv, "seed": k, "fit_exit": "runner error",
+                       "fit_error": repr(e)}
+                row = {f: row.get(f) for f in CSV_FIELDS} | row
+            rows.append(row)
+            print(f"  [{len(rows)}/{len(jobs)}] {c.name} {s.name} noise {lv:g} seed {k}: "
+                  f"error {pct(row.get('max_rel_error'))}, verdict {row.get('verdict')}, "
+                  f"truth fit {row.get('truth_fit_percent')}, select {row.get('select_recovered')}", file=sys.stderr)
+    rows.sort(key=lambda r: ([c.name for c in configs].index(r["config"]), [s.name for s in systems].index(r["system"]),
+                             r["noise"], r["seed"]))
+    markdown = tables(rows, configs, systems, levels)
+    print(markdown)
+    out = a.out or a.work
+    write_results(out, rows, markdown)
+    print(f"fidelity: {len(rows)} cases in {time.monotonic() - start:.0f} s; wrote {out}/results.csv, results.json, tables.md",
+          file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

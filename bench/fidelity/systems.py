@@ -1,0 +1,182 @@
+"""The eight known-truth systems of the fidelity benchmark (issue 13, item 7).
+
+Each system gives: its equations as a sidc model with the true terms (every parameter free, one
+term with a known coefficient, as sidc requires), the true parameter values, a candidate library
+for `sidc select` (the true terms and about as many plausible wrong ones) with the names of the
+true candidates, the sampling (step, samples), the input signals (smooth multisines: several
+incommensurate frequencies, so the record excites the dynamics over a band), the initial state and
+the right-hand side that `integrate.py` solves. Sampling: tens of samples or more per period of
+the fastest input component and of the fastest mode, a few thousand samples.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+
+def multisine(*components, offset=0.0):
+    """x(t) = offset + sum a*sin(w*t + phi) over (a, w, phi)."""
+    return lambda t: offset + sum(a * math.sin(w * t + p) for a, w, p in components)
+
+
+@dataclass
+class System:
+    name: str
+    title: str
+    inputs: dict                 # input name -> function of t
+    outputs: list                # output names (recorded, noisy)
+    states: list                 # state names as `sidc simulate --initial` takes them ("y", "y'")
+    output_state: dict           # output name -> index in the state vector
+    x0: list                     # true initial state
+    step: float
+    samples: int
+    substeps: int                # RK4 steps per sample interval in the generator
+    truth: dict                  # parameter -> true value
+    equations: str               # the true model's equations (sidc syntax)
+    library: str                 # candidate equations for `sidc select`
+    library_truth: dict          # equation index (1-based) -> set of true candidate names
+    rhs: object = None           # f(t, state, inputs) -> state derivative
+    sliding: object = None       # (accel, friction, torque) for Coulomb friction
+    notes: str = ""
+    library_params: list = field(default_factory=list)
+
+
+def _duffing():
+    m, c, k, k3 = 1.0, 0.25, 1.0, 0.5
+    x = multisine((1.5, 0.7, 0.0), (0.8, 1.9, 0.3), (0.4, 3.7, 0.0))
+    return System(
+        name="duffing", title="forced Duffing oscillator",
+        inputs={"x": x}, outputs=["y"], states=["y", "y'"], output_state={"y": 0},
+        x0=[0.0, 0.0], step=0.05, samples=3000, substeps=20,
+        truth={"m": m, "c": c, "k": k, "k3": k3},
+        equations="m*y'' + c*y' + k*y + k3*y^3 = x",
+        library="m*y'' + c*y' + k*y + k3*y^3 + k2*y^2 + c3*y'^3 + d*y^2*y' + e*y*y' = x",
+        library_truth={1: {"m", "c", "k", "k3"}},
+        rhs=lambda t, s, u: [s[1], (u["x"] - c * s[1] - k * s[0] - k3 * s[0] ** 3) / m],
+        notes="x = 1.5 sin 0.7t + 0.8 sin(1.9t + 0.3) + 0.4 sin 3.7t (as bench/fit_bench.cpp)")
+
+
+def _van_der_pol():
+    mu = 1.0
+    return System(
+        name="vanderpol", title="van der Pol oscillator (unforced, mu = 1)",
+        inputs={}, outputs=["y"], states=["y", "y'"], output_state={"y": 0},
+        x0=[0.2, 0.0], step=0.05, samples=2400, substeps=20,
+        truth={"c1": -mu, "c2": mu, "k": 1.0},
+        equations="y'' + c1*y' + c2*y^2*y' + k*y = 0",
+        library="y'' + c1*y' + c2*y^2*y' + k*y + k2*y^2 + k3*y^3 + c3*y'^3 + e*y*y' = 0",
+        library_truth={1: {"c1", "c2", "k"}},
+        rhs=lambda t, s, u: [s[1], mu * (1 - s[0] ** 2) * s[1] - s[0]],
+        notes="starts at y = 0.2 inside the limit cycle, so the record holds the growth onto it")
+
+
+def _lotka_volterra():
+    a, b, c, d = 1.0, 0.4, 0.8, 0.2
+    return System(
+        name="lotka", title="Lotka-Volterra (two outputs)",
+        inputs={}, outputs=["u", "v"], states=["u", "v"], output_state={"u": 0, "v": 1},
+        x0=[6.0, 2.0], step=0.05, samples=2000, substeps=20,
+        truth={"a": a, "b": b, "c": c, "d": d},
+        equations="u' = a*u - b*u*v\nv' = -c*v + d*u*v",
+        library="u' = a*u - b*u*v + a2*u^2 + a3*v + a4\nv' = -c*v + d*u*v + c2*v^2 + c3*u + c4",
+        library_truth={1: {"a", "b"}, 2: {"c", "d"}},
+        rhs=lambda t, s, u: [a * s[0] - b * s[0] * s[1], -c * s[1] + d * s[0] * s[1]],
+        notes="equilibrium u = 4, v = 2.5; the orbit through (6, 2)")
+
+
+def _third_order():
+    # (s + 1)(s^2 + s + 2.5) = s^3 + 2 s^2 + 3.5 s + 2.5, static gain 1
+    a2, a1, a0, b0 = 2.0, 3.5, 2.5, 2.5
+    x = multisine((1.0, 0.4, 0.0), (0.6, 1.1, 0.5), (0.4, 2.3, 1.0), (0.3, 3.9, 2.0))
+    return System(
+        name="linear3", title="third-order linear system",
+        inputs={"x": x}, outputs=["y"], states=["y", "y'", "y''"], output_state={"y": 0},
+        x0=[0.0, 0.0, 0.0], step=0.05, samples=3000, substeps=20,
+        truth={"a2": a2, "a1": a1, "a0": a0, "b0": b0},
+        equations="y''' + a2*y'' + a1*y' + a0*y = b0*x",
+        library="y''' + a2*y'' + a1*y' + a0*y + q3*y^3 + q2*y*y' + e = b0*x + b1*x' + b2*x''",
+        library_truth={1: {"a2", "a1", "a0", "b0"}},
+        rhs=lambda t, s, u: [s[1], s[2], b0 * u["x"] - a0 * s[0] - a1 * s[1] - a2 * s[2]],
+        notes="poles -1 and -0.5 +- 1.5i; x = sin 0.4t + 0.6 sin(1.1t + 0.5) + 0.4 sin(2.3t + 1) + 0.3 sin(3.9t + 2)")
+
+
+def _piecewise():
+    m, cm, cp, km, kp = 1.0, 0.3, 0.8, 1.0, 3.0
+    x = multisine((2.0, 0.9, 0.0), (1.2, 2.3, 0.7), (0.6, 4.1, 1.3))
+
+    def rhs(t, s, u):
+        y, v = s
+        damper = cm * v if v <= 0 else cp * v
+        spring = km * y if y <= 0 else kp * y
+        return [v, (u["x"] - damper - spring) / m]
+
+    return System(
+        name="piecewise", title="piecewise damper and spring (as eq. 4-1.8)",
+        inputs={"x": x}, outputs=["y"], states=["y", "y'"], output_state={"y": 0},
+        x0=[0.0, 0.0], step=0.04, samples=3000, substeps=25,
+        truth={"m": m, "cm": cm, "cp": cp, "km": km, "kp": kp},
+        equations="m*y'' + cm*y'*[y' <= 0] + cp*y'*[y' > 0] + km*y*[y <= 0] + kp*y*[y > 0] = x",
+        library=("m*y'' + cm*y'*[y' <= 0] + cp*y'*[y' > 0] + km*y*[y <= 0] + kp*y*[y > 0] +\n"
+                 "    cm3*y'^3*[y' <= 0] + cp3*y'^3*[y' > 0] + km3*y^3*[y <= 0] + kp3*y^3*[y > 0] + k2*y^2 = x"),
+        library_truth={1: {"m", "cm", "cp", "km", "kp"}},
+        rhs=rhs,
+        notes="damper 0.3 y' (y' <= 0) / 0.8 y' (y' > 0), spring 1.0 y (y <= 0) / 3.0 y (y > 0): "
+              "forces continuous at the switches, slopes not")
+
+
+def _stiff():
+    a1, a2, b1, a3, a4, c1 = 50.0, 10.0, 50.0, 0.5, 0.3, 1.0
+    x = multisine((1.0, 0.6, 0.0), (0.5, 5.0, 1.0), (0.3, 40.0, 0.5))
+    return System(
+        name="stiff", title="stiff slow-fast system (time constants 0.02 and 2)",
+        inputs={"x": x}, outputs=["y1", "y2"], states=["y1", "y2"], output_state={"y1": 0, "y2": 1},
+        x0=[0.0, 0.0], step=0.002, samples=5000, substeps=20,
+        truth={"a1": a1, "a2": a2, "b1": b1, "a3": a3, "a4": a4, "c1": c1},
+        equations="y1' + a1*y1 + a2*y2 = b1*x\ny2' + a3*y2 + a4*y2^3 = c1*y1",
+        library=("y1' + a1*y1 + a2*y2 + p1*y1^2 + p2*y2^2 + p3*y1*y2 = b1*x\n"
+                 "y2' + a3*y2 + a4*y2^3 + q1*y2^2 + q2*x + q3*y1*y2 = c1*y1"),
+        library_truth={1: {"a1", "a2", "b1"}, 2: {"a3", "a4", "c1"}},
+        rhs=lambda t, s, u: [b1 * u["x"] - a1 * s[0] - a2 * s[1], c1 * s[0] - a3 * s[1] - a4 * s[1] ** 3],
+        notes="fast mode 1/50, slow mode about 2; x = sin 0.6t + 0.5 sin(5t + 1) + 0.3 sin(40t + 0.5)")
+
+
+def _process():
+    # thesis eq. 4-2.5 (time in minutes)
+    p = {"a1": -0.169520, "a2": -0.150604, "a3": -0.013276, "a4": 7.607216,
+         "a5": -0.166036, "a6": -0.170566, "a7": -0.001100, "a8": 8.578805}
+    x = multisine((30.0, 0.25, 0.0), (15.0, 0.07, 1.0), (10.0, 0.6, 2.0), offset=100.0)
+    return System(
+        name="process", title="two-output process (thesis eq. 4-2.5, smooth input)",
+        inputs={"x": x}, outputs=["y1", "y2"], states=["y1", "y2"], output_state={"y1": 0, "y2": 1},
+        x0=[0.0, 50.0], step=0.1, samples=3000, substeps=10,
+        truth=p,
+        equations="y1' = a1*y1 + a2*y2 + a3*x + a4\ny2' = a5*y1 + a6*y2 + a7*x + a8",
+        library=("y1' = a1*y1 + a2*y2 + a3*x + a4 + p1*y1^2 + p2*y1*y2 + p3*y1*x + p4*x'\n"
+                 "y2' = a5*y1 + a6*y2 + a7*x + a8 + q1*y1^2 + q2*y1*y2 + q3*y1*x + q4*x'"),
+        library_truth={1: {"a1", "a2", "a3", "a4"}, 2: {"a5", "a6", "a7", "a8"}},
+        rhs=lambda t, s, u: [p["a1"] * s[0] + p["a2"] * s[1] + p["a3"] * u["x"] + p["a4"],
+                             p["a5"] * s[0] + p["a6"] * s[1] + p["a7"] * u["x"] + p["a8"]],
+        notes="x = 100 + 30 sin 0.25t + 15 sin(0.07t + 1) + 10 sin(0.6t + 2); y1(0) = 0, y2(0) = 50")
+
+
+def _pendulum():
+    J, c, f, k = 0.5, 0.1, 0.2, 2.0
+    x = multisine((0.5, 1.7, 0.0), (0.4, 0.6, 0.4), (0.3, 3.1, 1.1))
+    torque = lambda t, y, v: x(t) - c * v - k * math.sin(y)
+    accel = lambda t, y, v, mode: (torque(t, y, v) - f * mode) / J
+    return System(
+        name="pendulum", title="pendulum with viscous and Coulomb friction",
+        inputs={"x": x}, outputs=["y"], states=["y", "y'"], output_state={"y": 0},
+        x0=[0.0, 0.0], step=0.02, samples=4000, substeps=20,
+        truth={"J": J, "c": c, "f": f, "k": k},
+        equations="J*y'' + c*y' + f*sign(y') + k*sin(y) = x",
+        library=("J*y'' + c*y' + f*sign(y') + k*sin(y) + k1*y + k3*y^3 + q*y'^2*sign(y') +\n"
+                 "    c3*y'^3 = x"),
+        library_truth={1: {"J", "c", "f", "k"}},
+        sliding=(accel, f, torque),
+        notes="y is the angle; x the applied torque 0.5 sin 1.7t + 0.4 sin(0.6t + 0.4) + 0.3 sin(3.1t + 1.1); "
+              "swings within +-1.3 rad; 43 velocity reversals located, never stuck (sticking is handled)")
+
+
+SYSTEMS = [_duffing(), _van_der_pol(), _lotka_volterra(), _third_order(), _piecewise(), _stiff(),
+           _process(), _pendulum()]
+BY_NAME = {s.name: s for s in SYSTEMS}

@@ -21,6 +21,7 @@ import concurrent.futures
 import json
 import math
 import os
+import re
 import shlex
 import statistics
 import subprocess
@@ -75,7 +76,9 @@ def run(cmd, cwd, timeout):
         rc, err = "timeout", f"timed out after {timeout} s"
     except OSError as e:
         rc, err = "not run", str(e)
-    return rc, err.strip().splitlines()[-1] if err.strip() else "", time.monotonic() - start
+    lines = [l for l in err.strip().splitlines() if l.strip()]
+    first_error = next((l for l in lines if "error" in l), lines[-1] if lines else "")
+    return rc, first_error.strip(), time.monotonic() - start
 
 
 def read_csv(path):
@@ -176,14 +179,38 @@ def run_case(sidc, work, config, system, level, seed, timeout):
         for g in sel.get("groups", []):
             sizes = {s["size"]: s for s in g.get("sizes", [])}
             best = sizes.get(g.get("chosen_size"))
-            if best is not None:
-                chosen |= set(best.get("parameters", {}))
+            if best is not None:  # integration constants (C1, C1@2, ...) are kept by select, not operations
+                chosen |= {n for n in best.get("parameters", {}) if not re.fullmatch(r"C\d+(@\d+)?", n)}
         true_set = set().union(*system.library_truth.values())
         row["selected"] = sorted(chosen)
         row["select_recovered"] = chosen == true_set
     else:
         row["select_error"] = err or "select.json missing"
     return row
+
+
+def sensitivity(sidc, work, systems, timeout):
+    """How strict "follows" is per system: the truth's fit % when one true parameter is off by
+    0.1% or 1% (the worst over the parameters, each changed alone), simulated like the truth."""
+    lines = ["| system | true parameters | one parameter +0.1% | one parameter +1% |", "| --- | ---: | ---: | ---: |"]
+    for s in systems:
+        d = os.path.join(work, "sensitivity", s.name)
+        t = records.write_case(d, s, 0.0, 1)
+        reference = read_csv(os.path.join(d, "truth.csv"))
+        cells = []
+        for rel in (0.0, 0.001, 0.01):
+            worst = math.inf
+            for changed in (s.truth if rel else [None]):
+                params = [f"{k}={v * (1 + rel) if k == changed else v!r}" for k, v in s.truth.items()]
+                initial = [f"{k}={v!r}" for k, v in t["initial_state"].items()]
+                rc, _, _ = run([sidc, "simulate", "model.sid", "--data", "truth.csv", "--substeps", "10", "-o", "sim.csv",
+                                "--param"] + params + ["--initial"] + initial, d, timeout)
+                sim = read_csv(os.path.join(d, "sim.csv")) if rc == 0 else {}
+                fp = min(fit_percent(reference[o], sim.get(o, [])) for o in s.outputs)
+                worst = min(worst, fp if math.isfinite(fp) else -math.inf)
+            cells.append(f"{worst:.2f}")
+        lines.append(f"| {s.name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 # ---------------------------------------------------------------------------------------- output
@@ -243,6 +270,26 @@ def tables(rows, configs, systems, levels):
                    f"the truth in {agree} of {n}; `sidc select` recovered the exact true set in {rec} of "
                    f"{len(low)} cases at noise up to 1%.")
         out.append("")
+    if len({r["config"] for r in rows}) > 1:
+        out.append("### Best configuration per case (chosen knowing the truth: what is reachable)")
+        out.append("")
+        out.append("The configuration with the smallest median largest relative error, and that error.")
+        out.append("")
+        out.append("| system | " + " | ".join(f"noise {100 * lv:g}%" for lv in levels) + " |")
+        out.append("| --- |" + " ---: |" * len(levels))
+        for s in systems:
+            cells = []
+            for lv in levels:
+                best = None
+                for c in configs:
+                    errs = [r["max_rel_error"] for r in rows if r["config"] == c.name and r["system"] == s.name and r["noise"] == lv]
+                    if errs and all(e is not None for e in errs):
+                        med = statistics.median(errs)
+                        if best is None or med < best[0]:
+                            best = (med, c.name)
+                cells.append(f"{pct(best[0])} `{best[1]}`" if best else "fail")
+            out.append(f"| {s.name} | " + " | ".join(cells) + " |")
+        out.append("")
     return "\n".join(out)
 
 
@@ -282,6 +329,8 @@ def main():
     p.add_argument("-j", "--jobs", type=int, default=2, help="cases run at once (default 2)")
     p.add_argument("--work", default="/tmp/sidc-fidelity", help="where the cases are written (default /tmp/sidc-fidelity)")
     p.add_argument("--out", help="where results.csv, results.json and tables.md go (default: WORK)")
+    p.add_argument("--sensitivity", action="store_true",
+                   help="only print how strict 'follows' is: fit %% of the truth with one parameter off by 0.1%% or 1%%")
     p.add_argument("--timeout", type=float, default=600, help="seconds per sidc command (default 600)")
     a = p.parse_args()
 
@@ -299,6 +348,10 @@ def main():
     systems = [BY_NAME[n] for n in a.system] if a.system else SYSTEMS
     levels = a.noise or (QUICK_LEVELS if a.quick else NOISE_LEVELS)
     seeds = 1 if a.quick else a.seeds
+
+    if a.sensitivity:
+        print(sensitivity(sidc, a.work, systems, a.timeout))
+        return
 
     # Noise-free records first (one solve per system, shared by every case).
     for s in systems:

@@ -99,7 +99,7 @@ def model_text(system, equations, kind, declare_params=True):
     return "\n".join(lines) + "\n"
 
 
-def write_case(directory, system, level, seed, record=None):
+def write_case(directory, system, level, seed, record=None, truth_csv=True):
     record = record or noise_free(system)
     os.makedirs(directory, exist_ok=True)
     outputs = noisy_outputs(record, level, seed)
@@ -125,6 +125,8 @@ def write_case(directory, system, level, seed, record=None):
     if record.check is not None:
         truth["generator_halving_difference"] = record.check
     files["truth.json"] = json.dumps(truth, indent=2) + "\n"
+    if not truth_csv:
+        del files["truth.csv"]
     for name, text in files.items():
         with open(os.path.join(directory, name), "w") as f:
             f.write(text)
@@ -138,6 +140,7 @@ def main():
     p.add_argument("--noise", type=float, default=0.01, help="noise level (fraction of each output's s.d.)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--check", action="store_true", help="verify each record by halving the generator's step")
+    p.add_argument("--no-truth-csv", action="store_true", help="leave out truth.csv (the noise-free record)")
     a = p.parse_args()
     for name in a.system or [s.name for s in SYSTEMS]:
         system = BY_NAME[name]
@@ -145,7 +148,7 @@ def main():
         if a.check:
             record.verify()
         d = os.path.join(a.out, f"{name}_noise{a.noise:g}_s{a.seed}")
-        write_case(d, system, a.noise, a.seed, record)
+        write_case(d, system, a.noise, a.seed, record, truth_csv=not a.no_truth_csv)
         amp = {k: (min(v), max(v)) for k, v in record.outputs.items()}
         print(f"{d}: {system.samples} samples, step {system.step}, outputs range "
               + ", ".join(f"{k} [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in amp.items())

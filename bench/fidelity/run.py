@@ -36,6 +36,10 @@ from systems import BY_NAME, SYSTEMS  # noqa: E402
 FOLLOWS_FIT_PERCENT = 90.0   # as kFollowsFitPercent in runtime/simulate/validate.hpp
 NOISE_LEVELS = [0.0, 0.001, 0.01, 0.05]
 QUICK_LEVELS = [0.001, 0.01]
+# Issue 13's targets for the default fit: largest relative error at 0.1% and 1% noise on the
+# smooth systems; 2% on the piecewise ones (guards, sign()).
+TARGETS = {0.001: 0.0005, 0.01: 0.003}
+NON_SMOOTH_TARGET = 0.02
 
 
 class Config:
@@ -221,7 +225,7 @@ def pct(e):
     if not math.isfinite(e):
         return "inf"
     v = 100 * e
-    return f"{v:.0f}%" if v >= 100 else f"{v:.2g}%"
+    return f"{v:.0f}%" if v >= 10 else f"{v:.2g}%"
 
 
 def error_cell(rows):
@@ -266,9 +270,18 @@ def tables(rows, configs, systems, levels):
         low = [r for r in mine if r["noise"] <= 0.01]
         rec = sum(1 for r in low if r["select_recovered"] is True)
         out.append("")
+        met = cells = 0
+        for s in systems:
+            for lv, target in TARGETS.items():
+                errs = [r["max_rel_error"] for r in mine if r["system"] == s.name and r["noise"] == lv]
+                if errs:
+                    cells += 1
+                    limit = target if s.smooth else NON_SMOOTH_TARGET
+                    met += all(e is not None and e <= limit for e in errs)
         out.append(f"{n} cases: `sidc fit` failed in {fails}, `sidc select` in {sfails}; the verdict agreed with "
                    f"the truth in {agree} of {n}; `sidc select` recovered the exact true set in {rec} of "
-                   f"{len(low)} cases at noise up to 1%.")
+                   f"{len(low)} cases at noise up to 1%; issue 13's error target met (worst seed) in {met} of "
+                   f"{cells} system x noise cells at 0.1% and 1% (0.05% and 0.3%; 2% for piecewise and pendulum).")
         out.append("")
     if len({r["config"] for r in rows}) > 1:
         out.append("### Best configuration per case (chosen knowing the truth: what is reachable)")

@@ -239,6 +239,8 @@ def error_cell(rows):
 
 
 def count_cell(rows, key):
+    if all(r[key] is None for r in rows):
+        return "-"  # nothing to judge: no validation (--no-validate), or sidc failed
     good = sum(1 for r in rows if r[key] is True)
     return f"{good}/{len(rows)}"
 

@@ -23,6 +23,7 @@ struct CompileArguments {
   std::string model;
   std::string output;
   std::string integrate;
+  std::string form;
   std::string dump;
   std::string dump_after;
 };
@@ -90,6 +91,12 @@ int run_compile(const CompileArguments& a) {
     }
     options.integrate.override_request = r;
   }
+  if (!a.form.empty()) {  // the same request as --integrate, named by its form (CLI11 checked the value)
+    ir::IntegrationRequest r;
+    r.weak = a.form == "weak";
+    if (a.form == "integrated") r.count = ir::IntegrationRequest::Count::automatic;
+    options.integrate.override_request = r;
+  }
   const bool dumping = !a.dump.empty() || !a.dump_after.empty();
   if (dumping) {
     auto stop = pass_to_stop_after(a);
@@ -137,9 +144,12 @@ void add_compile_command(CLI::App& app, int& exit_status) {
   CLI::App* cmd = app.add_subcommand("compile", "Check a model file, rewrite it into integrated form, and write the compiled model");
   cmd->add_option("model", args->model, "The model file (.sid)")->required();
   cmd->add_option("-o,--output", args->output, "Where to write the compiled model (default: MODEL with extension .sidc.json)");
-  cmd->add_option("--integrate", args->integrate, "Integrate every equation N times (0-8), or `auto`; overrides the file");
+  auto* integrate = cmd->add_option("--integrate", args->integrate, "Integrate every equation N times (0-8), or `auto`; overrides the file");
+  cmd->add_option("--form", args->form, "Rewrite every equation into this form: derivative, integrated (as --integrate auto) or weak; overrides the file")
+      ->check(CLI::IsMember({"derivative", "integrated", "weak"}))
+      ->excludes(integrate);
   auto* dump = cmd->add_option("--dump", args->dump, "Print one stage instead of compiling: ast, normalized or integrated");
-  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, integrate)")
+  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, integrate, weak)")
       ->excludes(dump);
   cmd->callback([args, &exit_status] { exit_status = run_compile(*args); });
 }

@@ -143,8 +143,16 @@ struct Declarer {
       diagnostics.add(diag::bad_setting_value(value_span, key, s.value, problem.expected));
       return;
     }
+    if (key == "form") {  // the same request as `integrate`, named by its form
+      current_integration.span = value_span;
+      current_integration.weak = s.value == "weak";
+      current_integration.count = s.value == "integrated" ? ir::IntegrationRequest::Count::automatic : ir::IntegrationRequest::Count::fixed;
+      current_integration.times = 0;
+      return;
+    }
     if (key == "integrate") {
       current_integration.span = value_span;
+      current_integration.weak = false;
       if (s.value == "auto") {
         current_integration.count = ir::IntegrationRequest::Count::automatic;
       } else {

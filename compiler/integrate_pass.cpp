@@ -47,7 +47,8 @@ std::optional<Sum> factor_at_window_start(const Factor& f) {
     case FactorKind::window_start:
     case FactorKind::initial_value: return ir::factor(f);
     case FactorKind::derivative:
-    case FactorKind::guard: return std::nullopt;  // no value at t0 in the IR
+    case FactorKind::guard:
+    case FactorKind::test_function: return std::nullopt;  // no value at t0 in the IR
   }
   return std::nullopt;
 }
@@ -88,6 +89,8 @@ bool take(std::vector<Term>& remaining, const Term& t) {
   remaining.erase(it);
   return true;
 }
+
+}  // namespace
 
 // An exact antiderivative of `t` whose derivative consists of terms all present in `remaining`
 // (t among them); those terms are removed. Candidates lower one derivative of a signal by one
@@ -143,6 +146,8 @@ std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remain
   return std::nullopt;
 }
 
+namespace {
+
 struct Integrator {
   ir::Model& model;
   Diagnostics& diagnostics;
@@ -170,6 +175,7 @@ struct Integrator {
 
   ir::Equation integrate(const ir::Equation& e, std::size_t index) {
     const auto& r = e.integration;
+    if (r.weak) return e;  // weak_pass's to rewrite
     const bool dynamic = is_dynamic(e.known) || std::any_of(e.terms.begin(), e.terms.end(),
                                                             [](const ir::ParameterTerm& p) { return is_dynamic(p.operation); });
     int times = r.times;

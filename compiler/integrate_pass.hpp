@@ -30,6 +30,11 @@ struct IntegrateOptions {
 
 ir::Model integrate_pass(ir::Model model, const IntegrateOptions& options, Diagnostics& diagnostics);
 
+// An exact antiderivative of `t` whose derivative is made of terms all present in `remaining` (t
+// among them), which are taken off `remaining`; nullopt, leaving `remaining` as it was, when there
+// is none (integrate_pass.cpp: y'' -> y', y^2*y' -> y^3/3, x'*y + x*y' -> x*y, der(u, 1) -> u).
+std::optional<ir::Sum> exact_antiderivative(const ir::Term& t, std::vector<ir::Term>& remaining, bool initial);
+
 // One integration of a parameter-free sum from t0 to t, constants of integration dropped
 // (`initial` = false) or their values at t0 subtracted (`initial` = true).
 ir::Sum antiderivative(const ir::Sum& s, bool initial);

@@ -536,6 +536,7 @@ std::optional<std::pair<std::string, Span>> foreign_quantity(const Sum& s, const
       case FactorKind::initial_value: name = f.name + "(t0)"; break;
       case FactorKind::integral: name = "int(...)"; break;
       case FactorKind::derivative: name = "der(...)"; break;
+      case FactorKind::test_function: name = "phi_j"; break;
     }
     found = std::pair{std::move(name), t.span};
     return ir::Step::stop;

@@ -7,6 +7,7 @@
 #include "compiler/explicit_form_pass.hpp"
 #include "compiler/lower_pass.hpp"
 #include "compiler/normalize_pass.hpp"
+#include "compiler/weak_pass.hpp"
 #include "ir/print.hpp"
 
 namespace sidc {
@@ -18,6 +19,7 @@ const std::vector<PassInfo>& passes() {
       {"lower", "expressions to canonical sums; needs every name declared, and gives normalize plain factors"},
       {"normalize", "the thesis' linear form sum a_k op_k = known; needs canonical sums to find like terms"},
       {"integrate", "integrated form (sections 2-1, 2-2); works on the linear form, one operation at a time"},
+      {"weak", "weak form for the equations that ask for it; after integrate, which leaves them alone, and like it on the linear form"},
   };
   return list;
 }
@@ -41,7 +43,9 @@ CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOpt
   r.normalized = normalize_pass(std::move(lowered), r.diagnostics);
   if (stop("normalize")) return r;
   r.integrated = integrate_pass(*r.normalized, options.integrate, r.diagnostics);
-  stop("integrate");
+  if (stop("integrate")) return r;
+  r.integrated = weak_pass(std::move(*r.integrated), r.diagnostics);
+  stop("weak");
   return r;
 }
 

@@ -19,7 +19,7 @@ struct PassInfo {
   const char* name;
   const char* reason;  // why it stands where it does
 };
-// parse, declare, lower, normalize, integrate: see pipeline.cpp.
+// parse, declare, lower, normalize, integrate, weak: see pipeline.cpp.
 const std::vector<PassInfo>& passes();
 
 struct CompileOptions {
@@ -30,7 +30,7 @@ struct CompileOptions {
 struct CompileResult {
   ParseResult parsed;
   std::optional<ir::Model> normalized;  // after normalize_pass
-  std::optional<ir::Model> integrated;  // after integrate_pass: what `sidc fit` solves
+  std::optional<ir::Model> integrated;  // after integrate_pass and weak_pass: what `sidc fit` solves
   std::string last_pass;                // the last pass that ran
   Diagnostics diagnostics;
   std::string lowered_text;             // lower_pass's equations, printed, for --dump-after=lower

@@ -279,6 +279,21 @@ Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size
                            "(`set from`/`set to`), fewer parameters, or `set edges = shorten`", margin));
 }
 
+Diagnostic weak_form_mixed(const Span& where) {
+  return error("weak-form-mixed", where,
+               "this equation shares parameters with an equation of the weak form but is not of the weak form itself",
+               "write `set form = weak` before every equation that shares its parameters, or before none of them");
+}
+
+Diagnostic weak_form_too_short(std::string_view record, std::size_t samples, std::size_t needed, std::size_t rows) {
+  return error("weak-form-too-short", {},
+               fmt::format("the fit window of `{}` holds {} samples; the weak form needs at least {} for {} subdomains of its "
+                           "narrowest test function",
+                           record, samples, needed, rows),
+               "use a longer record or a wider window (`set from`/`set to`), fewer parameters, or another form "
+               "(`set form = derivative` or `integrated`)");
+}
+
 Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record) {
   return error("weight-not-valid", where,
                fmt::format("the weights `{}` are {} at t = {} in `{}`; a weight must be a finite number >= 0 (eq. 2-1.6)", weights,

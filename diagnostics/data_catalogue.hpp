@@ -82,6 +82,11 @@ Diagnostic initial_value_outside_record(const Span& where, std::string_view valu
 Diagnostic no_data_file(const Span& where);
 Diagnostic signal_not_in_record(const Span& where, std::string_view signal, std::string_view record);
 Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size_t parameters, int margin);
+// The weak form's narrowest subdomains do not fit `rows` times into the fit window of `record`.
+// An equation of another form sharing parameters with a weak-form one (rows of samples and of
+// subdomains cannot be stacked).
+Diagnostic weak_form_mixed(const Span& where);
+Diagnostic weak_form_too_short(std::string_view record, std::size_t samples, std::size_t needed, std::size_t rows);
 // `set weights = <expression>` (eq. 2-1.6) is negative, NaN or infinite on a row of the fit window.
 Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record);
 

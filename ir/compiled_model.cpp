@@ -1,10 +1,12 @@
 #include "ir/compiled_model.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 #include <set>
 
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "ir/settings.hpp"
 
 namespace sidc {
@@ -27,6 +29,7 @@ const char* kind_name(FactorKind k) {
     case FactorKind::derivative: return "derivative";
     case FactorKind::integral: return "integral";
     case FactorKind::guard: return "guard";
+    case FactorKind::test_function: return "test_function";
   }
   return "?";
 }
@@ -70,6 +73,7 @@ ordered factor_json(const ir::Factor& f, int power) {
       j["conditions"] = std::move(conditions);
       break;
     }
+    case FactorKind::test_function: j["order"] = f.order; break;
     case FactorKind::time:
     case FactorKind::elapsed:
     case FactorKind::window_start: break;  // the kind says it all
@@ -200,6 +204,7 @@ ordered model_json(const ir::Model& m) {
                {"constants", e.integration.constants == ir::IntegrationRequest::Constants::initial ? "initial" : "fitted"},
                {"operations", operations_json(e.terms, m)}};
     eq["known"] = sum_json(e.known);
+    if (e.weak) eq["weak"] = true;  // written only when set: files of the other forms stay as they were
     equations.push_back(std::move(eq));
   }
   return equations;
@@ -231,10 +236,16 @@ std::vector<ir::Equation> read_equations(const json& j, const ir::Model& m, cons
     ir::Equation eq;
     eq.span = r.span(e.at("span"));
     eq.integrations = e.at("integrations").get<int>();
+    eq.weak = e.value("weak", false);
     eq.integration.constants = one_of(e, "constants", {"fitted", "initial"}) == "initial" ? ir::IntegrationRequest::Constants::initial
                                                                                            : ir::IntegrationRequest::Constants::fitted;
     eq.terms = read_operations(e.at("operations"), m, r);
     eq.known = r.sum(e.at("known"));
+    // Test functions are the weak form's alone: elsewhere nothing would integrate them away.
+    const auto test_function = [](const ir::Factor& f) { return f.kind == FactorKind::test_function; };
+    const bool has_test_function = ir::any_factor(eq.known, test_function) ||
+        std::any_of(eq.terms.begin(), eq.terms.end(), [&](const ir::ParameterTerm& p) { return ir::any_factor(p.operation, test_function); });
+    if (has_test_function && !eq.weak) throw std::runtime_error("a test function `phi_j` in an equation that is not of the weak form");
     equations.push_back(std::move(eq));
   }
   return equations;

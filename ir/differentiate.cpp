@@ -25,6 +25,7 @@ std::optional<Sum> derivative_of(const Factor& f) {
     case FactorKind::time:
     case FactorKind::elapsed: return ir::number(1);
     case FactorKind::integral: return *f.argument;  // d/dt int(u) = u
+    case FactorKind::test_function:  // phi_j^(k)' = phi_j^(k+1), known exactly
     case FactorKind::derivative: {
       Factor next = f;
       ++next.order;

@@ -77,6 +77,7 @@ int compare(const Factor& a, const Factor& b) {
       if (a.order != b.order) return three_way(b.order, a.order);
       return compare_ptr(a.argument, b.argument);
     case FactorKind::integral: return compare_ptr(a.argument, b.argument);
+    case FactorKind::test_function: return three_way(a.order, b.order);
     case FactorKind::guard: {
       const std::size_t n = std::min(a.conditions.size(), b.conditions.size());
       for (std::size_t i = 0; i < n; ++i) {

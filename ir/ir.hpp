@@ -36,6 +36,7 @@ struct Condition {
 // The kinds of factor, in the order they are written within a term.
 enum class FactorKind {
   parameter,      // a_k: only before normalize_pass splits parameters off
+  test_function,  // phi_j and its derivatives (`order`): the weak form's test function on subdomain j
   signal,         // y, y', y'': `name`, derivative `order`
   initial_value,  // y(0), y'(t0): `name`, `order`, `at` (nullopt = t0); a constant read from the record
   window_start,   // t0, the start of the fit window (a constant)
@@ -134,6 +135,9 @@ struct IntegrationRequest {
   // values at the window start, subtracted from each antiderivative (eqs. 2-1.4, 4-2.4).
   enum class Constants { fitted, initial };
   Constants constants = Constants::fitted;
+  // `set form = weak`: integrated against test functions instead (weak_pass.cpp); count and times
+  // are then unused. `set form` and `set integrate` set this request alike: the later one wins.
+  bool weak = false;
   Span span;  // of the setting, for diagnostics
 };
 
@@ -149,6 +153,9 @@ struct Equation {
   Sum known;
   IntegrationRequest integration;
   int integrations = 0;  // how many times integrate_pass integrated it
+  // Weak form (weak_pass.cpp): every operation is a sum of phi_j^(k) * g terms, and the equation
+  // holds integrated over each test function's subdomain j, one row per subdomain.
+  bool weak = false;
 };
 
 // The moving-arc derivative operator and the other evaluation settings a model file can carry.

@@ -101,6 +101,7 @@ std::string print(const ir::Factor& f) {
     }
     case FactorKind::derivative: return fmt::format("der({}, {})", print(*f.argument), f.order);
     case FactorKind::integral: return fmt::format("int({})", print(*f.argument));
+    case FactorKind::test_function: return "phi_j" + std::string(static_cast<std::size_t>(f.order), '\'');
     case FactorKind::guard: {
       std::string out = "[";
       for (std::size_t i = 0; i < f.conditions.size(); ++i) {
@@ -210,7 +211,10 @@ std::string print(const ir::Model& m) {
   ir::IntegrationRequest current;
   for (const auto& e : m.equations) {
     const auto& r = e.integration;
-    if (r.count != current.count || r.times != current.times)
+    if (r.weak && !current.weak) out += "set form = weak\n";
+    if (e.weak && (&e == &m.equations.front() || !(&e - 1)->weak))
+      out += "# weak form: each equation below holds integrated against every test function phi_j over its subdomain\n";
+    if (!r.weak && (r.count != current.count || r.times != current.times || current.weak))
       out += fmt::format("set integrate = {}\n", r.count == ir::IntegrationRequest::Count::automatic ? "auto" : std::to_string(r.times));
     if (r.constants != current.constants)
       out += fmt::format("set constants = {}\n", r.constants == ir::IntegrationRequest::Constants::initial ? "initial" : "fitted");

@@ -19,7 +19,8 @@ bool is_dynamic(const ir::Sum& s) {
       case ir::FactorKind::time:
       case ir::FactorKind::elapsed:
       case ir::FactorKind::derivative:
-      case ir::FactorKind::integral: return true;
+      case ir::FactorKind::integral:
+      case ir::FactorKind::test_function: return true;
       case ir::FactorKind::parameter:
       case ir::FactorKind::window_start:
       case ir::FactorKind::initial_value: return false;  // constants

@@ -25,7 +25,7 @@ std::optional<int> whole_number(const std::string& text) {
 }  // namespace
 
 const std::vector<std::string>& setting_keys() {
-  static const std::vector<std::string> keys{"integrate", "constants", "derivative", "second_derivative", "edges",
+  static const std::vector<std::string> keys{"integrate", "form", "constants", "derivative", "second_derivative", "edges",
                                              "integration", "smooth_before_integration", "from", "to", "every", "step", "weights"};
   return keys;
 }
@@ -45,6 +45,10 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
     const auto n = whole_number(value);
     if (value != "auto" && (!n || *n < 0 || *n > kMaxIntegrations))
       r.expected = "a whole number of integrations from 0 to 8, or `auto`";
+  } else if (key == "form") {
+    if (value != "derivative" && value != "integrated" && value != "weak")
+      r.expected = "`derivative` (no integration), `integrated` (as `integrate = auto`) or `weak` (integrated against test "
+                   "functions on subdomains: no derivative of the data, no integration constant)";
   } else if (key == "constants") {
     if (value != "fitted" && value != "initial")
       r.expected = "`fitted` (integration constants become parameters, eq. 2-1.5) or `initial` (taken from the record, eq. 4-2.4)";

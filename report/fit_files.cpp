@@ -57,9 +57,14 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
   for (const auto& g : s.groups) {
     const auto& ls = g.summary;
     ordered_json equations = ordered_json::array();
-    for (std::size_t e : g.equations) equations.push_back({{"index", e + 1}, {"text", print(m.equations[e], m)}, {"integrations", m.equations[e].integrations}});
+    for (std::size_t e : g.equations) equations.push_back({{"index", e + 1}, {"text", print(m.equations[e], m)}, {"integrations", m.equations[e].integrations},
+                                                     {"form", m.equations[e].weak ? "weak" : m.equations[e].integrations ? "integrated" : "derivative"}});
     ordered_json records = ordered_json::array();
-    for (const auto& r : g.records) records.push_back({{"path", r.path}, {"t0", r.t0}, {"t_last", r.t_last}, {"step", r.step}, {"rows", r.rows}});
+    for (std::size_t r = 0; r < g.records.size(); ++r) {
+      const auto& rec = g.records[r];
+      records.push_back({{"path", rec.path}, {"t0", rec.t0}, {"t_last", rec.t_last}, {"step", rec.step}, {"rows", rec.rows}});
+      if (r < g.subdomains.size()) records.back()["weak_subdomains"] = g.subdomains[r];
+    }
     ordered_json parameters = ordered_json::array();
     for (const auto& p : ls.parameters)
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}}});

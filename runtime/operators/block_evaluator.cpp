@@ -3,6 +3,7 @@
 #include "runtime/operators/block_evaluator.hpp"
 
 #include <algorithm>
+#include <fmt/format.h>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -230,10 +231,12 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       }
       return v;
     }
-    case FactorKind::parameter: break;
+    case FactorKind::parameter:
+    case FactorKind::test_function: break;
   }
-  // normalize_pass takes every parameter out of the operations; one here is a bug (exit code 3).
-  throw std::logic_error("a parameter factor reached the block evaluator");
+  // normalize_pass takes every parameter out of the operations, and the weak form is never
+  // streamed (runtime/solve/weak_design.cpp); one here is a bug (exit code 3).
+  throw std::logic_error(fmt::format("the factor `{}` reached the block evaluator", print(f)));
 }
 
 }  // namespace sidc

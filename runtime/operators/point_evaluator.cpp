@@ -96,6 +96,7 @@ class PointSumCompiler {
       case K::integral: return diag::simulate_integral(t.span, print(f));
       case K::derivative: return diag::simulate_estimated_derivative(t.span, print(f));
       case K::parameter: throw std::logic_error("a parameter factor reached the point evaluator");
+      case K::test_function: throw std::logic_error("a test function reached the point evaluator (simulation solves the normalized model)");
     }
     return problem;
   }

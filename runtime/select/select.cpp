@@ -19,6 +19,7 @@
 #include "runtime/select/forward_regression.hpp"
 #include "runtime/select/sequential_threshold.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
+#include "runtime/solve/weak_design.hpp"
 
 namespace sidc {
 
@@ -227,19 +228,33 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     // Rows, folded into `fine` contiguous blocks of time per record (block b of every record
     // goes to triangle b).
     std::vector<TriangularAccumulator> blocks(static_cast<std::size_t>(fine), TriangularAccumulator(p));
+    auto weak = is_weak_group(model, members);
+    if (auto* d = std::get_if<Diagnostic>(&weak)) return *d;
     for (std::size_t r = 0; r < records.size(); ++r) {
       Evaluator evaluator(records[r], model, options.fit.evaluation, windows[r]);
-      const std::size_t W = windows[r].size(), E = members.size();
-      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(W * E), p);
-      Eigen::VectorXd b(static_cast<Eigen::Index>(W * E));
-      Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(W * E));
       std::vector<double> expression;  // eq. 2-1.6 as sidc fit applies it
       if (model.weights) {
         auto values = expression_weights(model, evaluator);
         if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
         expression = std::get<std::vector<double>>(std::move(values));
       }
-      if (auto problem = design.window_rows(r, evaluator, expression, A, b, weights, 0)) return *problem;
+      // Rows per equation: the window's samples, or the weak form's subdomains (weak_design.hpp).
+      std::size_t W = windows[r].size();
+      const std::size_t E = members.size();
+      Eigen::MatrixXd A;
+      Eigen::VectorXd b, weights;
+      if (std::get<bool>(weak)) {
+        auto made = weak_record_design(model, records, r, evaluator, design, members, expression);
+        if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
+        WeakDesign& wd = std::get<WeakDesign>(made);
+        W = wd.grids.front().centres.size();
+        A = std::move(wd.A), b = std::move(wd.b), weights = std::move(wd.weights);
+      } else {
+        A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(W * E), p);
+        b.resize(static_cast<Eigen::Index>(W * E));
+        weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(W * E));
+        if (auto problem = design.window_rows(r, evaluator, expression, A, b, weights, 0)) return *problem;
+      }
       const bool weighted = !records[r].weights.empty() || !expression.empty();
       for (int block = 0; block < fine; ++block) {
         const std::size_t first = W * static_cast<std::size_t>(block) / static_cast<std::size_t>(fine);

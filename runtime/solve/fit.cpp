@@ -21,6 +21,7 @@
 #include "ir/traversal.hpp"
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
+#include "runtime/solve/weak_design.hpp"
 
 namespace sidc {
 
@@ -291,6 +292,36 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   return std::nullopt;
 }
 
+// A group of weak-form equations (weak_design.hpp): always dense, one row per subdomain.
+std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vector<SampledRecord>& records,
+                                         std::vector<Evaluator>& evaluators, const DesignBuilder& design, const FitOptions& options,
+                                         GroupFit& g) {
+  std::vector<std::vector<double>> weights_of_expression(model.weights ? records.size() : 0);
+  for (std::size_t r = 0; r < weights_of_expression.size(); ++r) {
+    auto values = expression_weights(model, evaluators[r]);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    weights_of_expression[r] = std::get<std::vector<double>>(std::move(values));
+  }
+  auto made = weak_design(model, records, evaluators, design, g.equations, weights_of_expression);
+  if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
+  WeakDesign& w = std::get<WeakDesign>(made);
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    g.records[r].rows = w.grids[r].centres.size();
+    g.subdomains.push_back(describe(w.grids[r], records[r].step));
+  }
+  g.row_equation = std::move(w.row_equation);
+  g.row_record = std::move(w.row_record);
+  g.row_time = std::move(w.row_time);
+  g.known.assign(w.b.data(), w.b.data() + w.b.size());
+  auto regions = count_regions(model, g.equations, evaluators);
+  if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
+  g.regions = std::get<std::vector<Region>>(std::move(regions));
+  if (auto problem = design.too_few_rows(static_cast<std::size_t>(w.b.size()), options.evaluation)) return problem;
+  g.summary = solve_least_squares(w.A, w.b, g.columns, g.weighted ? &w.weights : nullptr, options.least_squares);
+  design.label(g.summary);
+  return std::nullopt;
+}
+
 }  // namespace
 
 bool FitOptions::is_valid(std::string* why) const {
@@ -355,6 +386,13 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
       g.records.push_back({records[r].path, records[r].time[w.first], records[r].time[w.last], records[r].step, w.first, w.size()});
     }
     g.weighted = model.weights || std::any_of(records.begin(), records.end(), [](const SampledRecord& r) { return !r.weights.empty(); });
+    auto weak = is_weak_group(model, members);
+    if (auto* d = std::get_if<Diagnostic>(&weak)) return *d;
+    if (std::get<bool>(weak)) {
+      if (auto problem = fit_weak_group(model, records, evaluators, design, options, g)) return *problem;
+      summary.groups.push_back(std::move(g));
+      continue;
+    }
     if (total_rows * g.columns.size() > options.stream_above_entries) {
       if (auto problem = stream_group(model, records, windows, options, design, total_rows, g)) return *problem;
       summary.groups.push_back(std::move(g));
@@ -472,9 +510,12 @@ std::string FitSummary::full_report(const ir::Model& model) const {
       std::string text = print_wrapped(eq, model, 96, 4);
       for (std::size_t p = text.find('\n'); p != std::string::npos; p = text.find('\n', p + 1)) text.insert(p + 1, "  ");
       out += fmt::format("equation {}{}:\n  {}\n", e + 1,
-                         eq.integrations ? fmt::format(" (integrated {} time{})", eq.integrations, eq.integrations == 1 ? "" : "s") : "",
+                         eq.weak ? " (weak form)"
+                         : eq.integrations ? fmt::format(" (integrated {} time{})", eq.integrations, eq.integrations == 1 ? "" : "s") : "",
                          text);
     }
+    for (std::size_t r = 0; r < g.subdomains.size(); ++r)
+      out += fmt::format("  weak form on {}: {}\n", g.records[r].path, g.subdomains[r]);
     for (const auto& r : g.records) {
       if (is_static(model))
         out += fmt::format("  record {}: rows {} to {}, n = {} per equation\n", r.path, r.first_sample + 1, r.first_sample + r.rows, r.rows);

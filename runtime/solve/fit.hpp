@@ -79,6 +79,8 @@ struct GroupFit {
   // Empty for a dense fit; for a streamed one, how (printed in the report), e.g. "streamed QR over
   // 9999988 rows in blocks of 2048 rows on 2 threads", and the per-row vectors above are empty.
   std::string streamed;
+  // Weak-form groups (weak_design.hpp): per record, its subdomains and how their width was chosen.
+  std::vector<std::string> subdomains;
   // CPU seconds (all threads) spent evaluating operations and folding rows (streamed fits), and
   // wall seconds of the final p x p solve, for the bench.
   double evaluate_seconds = 0, fold_seconds = 0, solve_seconds = 0;

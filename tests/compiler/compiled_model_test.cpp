@@ -91,8 +91,8 @@ std::vector<Case> cases() {
   models.emplace_back("every_kind.sid", kEveryKindModel);
 
   std::vector<std::pair<std::string, std::optional<ir::IntegrationRequest>>> integrations{{"as written", std::nullopt}};
-  for (int n : {1, 2}) integrations.push_back({"--integrate " + std::to_string(n), ir::IntegrationRequest{{}, n, {}, {}}});
-  integrations.push_back({"--integrate auto", ir::IntegrationRequest{ir::IntegrationRequest::Count::automatic, 0, {}, {}}});
+  for (int n : {1, 2}) integrations.push_back({"--integrate " + std::to_string(n), ir::IntegrationRequest{{}, n, {}, false, {}}});
+  integrations.push_back({"--integrate auto", ir::IntegrationRequest{ir::IntegrationRequest::Count::automatic, 0, {}, false, {}}});
 
   std::vector<Case> out;
   for (const auto& [name, text] : models)
@@ -231,7 +231,7 @@ TEST(CompiledModelSchema, EveryGoldenModelValidates) {
 json van_der_pol() {
   const fs::path path = fs::path(SIDC_SOURCE_DIR) / "tests/golden/integrated/thesis_2_2_8_van_der_pol_once.sid";
   Case c{"van der pol", std::make_shared<const SourceFile>("thesis_2_2_8_van_der_pol_once.sid", read_text(path)), {}};
-  c.options.integrate.override_request = ir::IntegrationRequest{{}, 1, {}, {}};
+  c.options.integrate.override_request = ir::IntegrationRequest{{}, 1, {}, false, {}};
   const auto model = compiled(c);
   EXPECT_TRUE(model.has_value());
   return model ? as_read(*model) : json::object();
@@ -255,7 +255,7 @@ TEST(CompiledModelSchema, RejectsDocumentsBrokenOnPurpose) {
       {"extra property deep down", [&](json& j) { j[first_factor]["note"] = 1; }, "unexpected property \"note\""},
       {"wrong format", [](json& j) { j["format"] = "sidc-model"; }, "/format: expected \"sidc-compiled-model\""},
       {"other version", [](json& j) { j["version"] = 1; }, "/version: expected 2"},
-      {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, "matches none of the 10 alternatives"},
+      {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, "matches none of the 11 alternatives"},
       {"zero power", [&](json& j) { j[first_factor]["power"] = 0; }, "/power"},
       {"zero denominator", [](json& j) { j["equations"][0]["known"]["terms"][0]["coefficient"]["den"] = 0; }, "/den: 0 is below"},
       {"an infinite coefficient (written as null)", [](json& j) { j["equations"][0]["known"]["terms"][0]["coefficient"] = {{"real", nullptr}}; },

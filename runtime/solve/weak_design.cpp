@@ -1,0 +1,186 @@
+#include "runtime/solve/weak_design.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "diagnostics/data_catalogue.hpp"
+#include "ir/traversal.hpp"
+
+namespace sidc {
+namespace {
+
+// The order of a term's test function and the term without it (weak_pass puts exactly one,
+// to the power 1, on every term; the compiled-model reader checks files for the same).
+std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
+  ir::Term rest = t;
+  int order = 0;
+  auto it = std::find_if(rest.factors.begin(), rest.factors.end(), [](const auto& f) { return f.first.kind == ir::FactorKind::test_function; });
+  if (it != rest.factors.end()) {
+    order = it->first.order;
+    rest.factors.erase(it);
+  }
+  return {order, rest};
+}
+
+int highest_test_function_order(const ir::Model& model, const std::vector<std::size_t>& equations) {
+  int k = 0;
+  const auto visit = [&](const ir::Sum& s) {
+    ir::for_each_factor(s, [&](const ir::Factor& f) {
+      if (f.kind == ir::FactorKind::test_function) k = std::max(k, f.order);
+    });
+  };
+  for (std::size_t e : equations) {
+    visit(model.equations[e].known);
+    for (const auto& p : model.equations[e].terms) visit(p.operation);
+  }
+  return k;
+}
+
+// The outputs the group's equations use: their spectrum sets the subdomains' width.
+std::set<std::string> outputs_used(const ir::Model& model, const std::vector<std::size_t>& equations) {
+  std::set<std::string> names;
+  const auto visit = [&](const ir::Sum& s) {
+    ir::for_each_factor(s, [&](const ir::Factor& f) {
+      if (f.kind != ir::FactorKind::signal) return;
+      const ir::Signal* signal = model.signal(f.name);
+      if (signal && signal->kind == ir::Signal::Kind::output) names.insert(f.name);
+    });
+  };
+  for (std::size_t e : equations) {
+    visit(model.equations[e].known);
+    for (const auto& p : model.equations[e].terms) visit(p.operation);
+  }
+  return names;
+}
+
+ir::Sum signal_sum(const std::string& name) { return ir::factor(ir::Factor{ir::FactorKind::signal, name, 0, {}, {}, {}, {}}); }
+
+}  // namespace
+
+std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations) {
+  const auto weak = std::count_if(equations.begin(), equations.end(), [&](std::size_t e) { return model.equations[e].weak; });
+  if (weak == 0 || weak == static_cast<std::ptrdiff_t>(equations.size())) return weak > 0;
+  const std::size_t strong = *std::find_if(equations.begin(), equations.end(), [&](std::size_t e) { return !model.equations[e].weak; });
+  return diag::weak_form_mixed(model.equations[strong].span);
+}
+
+WeakValues::WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid) : evaluator_(evaluator), grid_(grid) {}
+
+std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, const std::string& what, std::span<double> out) {
+  std::map<int, std::vector<ir::Term>> parts;  // g_k by the order k of phi_j^(k)
+  for (const auto& t : sum.terms) {
+    auto [k, rest] = split_test_function(t);
+    parts[k].push_back(ir::canonical(rest));
+  }
+  std::fill(out.begin(), out.end(), 0.0);
+  const std::size_t m = grid_.half_width;
+  for (const auto& [k, terms] : parts) {
+    auto values = evaluator_.evaluate_in_window(ir::canonical(terms), what);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const std::vector<double>& g = std::get<std::vector<double>>(values);
+    if (weights_.size() <= static_cast<std::size_t>(k)) weights_.resize(static_cast<std::size_t>(k) + 1);
+    auto& w = weights_[static_cast<std::size_t>(k)];
+    if (w.empty()) w = test_function_weights(grid_, k, evaluator_.record().step);
+    for (std::size_t j = 0; j < grid_.centres.size() && j < out.size(); ++j) {
+      const double* x = g.data() + (grid_.centres[j] - m);
+      double s = 0;
+      for (std::size_t i = 0; i < w.size(); ++i) s += w[i] * x[i];
+      out[j] += s;
+    }
+  }
+  return std::nullopt;
+}
+
+std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, const std::vector<SampledRecord>& records, std::size_t r,
+                                                        Evaluator& evaluator, const DesignBuilder& design,
+                                                        const std::vector<std::size_t>& equations, std::span<const double> expression) {
+  WeakDesign out;
+  std::vector<std::vector<double>> values;
+  for (const auto& name : outputs_used(model, equations)) {
+    auto v = evaluator.evaluate_in_window(signal_sum(name), "the output `" + name + "`");
+    if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
+    values.push_back(std::get<std::vector<double>>(std::move(v)));
+  }
+  const std::vector<std::span<const double>> spans(values.begin(), values.end());
+  const std::size_t fewest_rows = std::max<std::size_t>(20, 4 * design.columns().size());
+  auto chosen = choose_test_functions(spans, evaluator.window().size(), records[r].step, highest_test_function_order(model, equations),
+                                      fewest_rows, records[r].path);
+  if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+  out.grids.push_back(std::get<TestFunctionGrid>(std::move(chosen)));
+  const TestFunctionGrid& grid = out.grids.back();
+  const FitWindow& w = evaluator.window();
+  const auto K = static_cast<Eigen::Index>(grid.centres.size());
+  const auto total = K * static_cast<Eigen::Index>(equations.size());
+  out.A = Eigen::MatrixXd::Zero(total, static_cast<Eigen::Index>(design.columns().size()));
+  out.b = Eigen::VectorXd::Zero(total);
+  out.weights = Eigen::VectorXd::Ones(total);
+  // eq. 2-1.6 on subdomains: each row's weight is the phi-weighted mean of its samples' weights.
+  std::vector<double> products(expression.size());
+  const double* sample_weight = design.row_weights(r, w.first, expression, products);
+  Eigen::VectorXd row_weight = Eigen::VectorXd::Ones(K);
+  if (sample_weight) {
+    const std::vector<double> phi = test_function_weights(grid, 0, 1.0);
+    double total_phi = 0;
+    for (double v : phi) total_phi += v;
+    for (Eigen::Index j = 0; j < K; ++j) {
+      double s = 0;
+      for (std::size_t i = 0; i < phi.size(); ++i) s += phi[i] * sample_weight[grid.centres[static_cast<std::size_t>(j)] - grid.half_width + i];
+      row_weight(j) = s / total_phi;
+    }
+  }
+  WeakValues weak(evaluator, grid);
+  Eigen::Index row = 0;
+  for (std::size_t e : equations) {
+    if (auto problem = design.equation_rows(r, e, weak, {out.A.middleRows(row, K), out.b.segment(row, K)})) return *problem;
+    out.weights.segment(row, K) = row_weight;
+    for (std::size_t c : grid.centres) {
+      out.row_equation.push_back(e);
+      out.row_record.push_back(r);
+      out.row_time.push_back(records[r].time[w.first + c]);
+    }
+    row += K;
+  }
+  return out;
+}
+
+std::variant<WeakDesign, Diagnostic> weak_design(const ir::Model& model, const std::vector<SampledRecord>& records,
+                                                 std::vector<Evaluator>& evaluators, const DesignBuilder& design,
+                                                 const std::vector<std::size_t>& equations,
+                                                 const std::vector<std::vector<double>>& expression_weights) {
+  std::vector<WeakDesign> parts;
+  Eigen::Index total = 0;
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    const std::span<const double> expression = r < expression_weights.size() ? std::span<const double>(expression_weights[r]) : std::span<const double>();
+    auto part = weak_record_design(model, records, r, evaluators[r], design, equations, expression);
+    if (auto* d = std::get_if<Diagnostic>(&part)) return *d;
+    parts.push_back(std::get<WeakDesign>(std::move(part)));
+    total += parts.back().b.size();
+  }
+  WeakDesign out;
+  out.A.resize(total, static_cast<Eigen::Index>(design.columns().size()));
+  out.b.resize(total);
+  out.weights.resize(total);
+  Eigen::Index row = 0;
+  for (auto& part : parts) {
+    const Eigen::Index n = part.b.size();
+    out.A.middleRows(row, n) = part.A;
+    out.b.segment(row, n) = part.b;
+    out.weights.segment(row, n) = part.weights;
+    out.row_equation.insert(out.row_equation.end(), part.row_equation.begin(), part.row_equation.end());
+    out.row_record.insert(out.row_record.end(), part.row_record.begin(), part.row_record.end());
+    out.row_time.insert(out.row_time.end(), part.row_time.begin(), part.row_time.end());
+    out.grids.push_back(std::move(part.grids.front()));
+    row += n;
+  }
+  return out;
+}
+
+std::string describe(const TestFunctionGrid& grid, double step) {
+  return fmt::format("{} subdomains of 2*{}+1 samples (half-width {:.4g}), phi = (1 - s^2)^{}; {}", grid.centres.size(), grid.half_width,
+                     static_cast<double>(grid.half_width) * step, grid.degree, grid.reason);
+}
+
+}  // namespace sidc

@@ -1,0 +1,69 @@
+// The design of weak-form equations (compiler/weak_pass.hpp): one row per subdomain of each
+// record, each operation integrated against the test function of that subdomain.
+//
+// Relies on: design.hpp (columns, the rows of an equation through DesignValues), evaluate.hpp
+// (each phi-free part of an operation on the whole fit window), test_functions.hpp (the subdomains
+// chosen from the record, the quadrature weights). Guarantees: an operation sum_k phi_j^(k) * g_k
+// gives row j the value sum_k integral(phi_j^(k) * g_k), each g_k evaluated once per record; the
+// rows run record by record, equation by equation, subdomain centres increasing (the times given
+// are the centres); a weighted row (eq. 2-1.6) carries the phi-weighted mean of its samples' weights.
+// The weak design has few rows (about 4 n / m), so it is always solved dense; its evaluation holds
+// each g_k on the whole window (memory linear in n).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "diagnostics/diagnostic.hpp"
+#include "ir/ir.hpp"
+#include "runtime/operators/evaluate.hpp"
+#include "runtime/operators/test_functions.hpp"
+#include "runtime/solve/design.hpp"
+
+namespace sidc {
+
+// True when the group's equations are of the weak form; a Diagnostic when they mix forms (their
+// rows would not be commensurable: samples against subdomains).
+std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations);
+
+// Row j of an operation: its integral against subdomain j's test function (see above).
+class WeakValues final : public DesignValues {
+ public:
+  WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid);
+  std::optional<Diagnostic> evaluate(const ir::Sum& sum, std::size_t index, const std::string& what,
+                                     std::span<double> out) override;
+
+ private:
+  Evaluator& evaluator_;
+  const TestFunctionGrid& grid_;
+  std::vector<std::vector<double>> weights_;  // per derivative order of phi, made when first asked for
+};
+
+struct WeakDesign {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b, weights;
+  std::vector<std::size_t> row_equation, row_record;
+  std::vector<double> row_time;
+  std::vector<TestFunctionGrid> grids;  // per record
+};
+
+// The weak design of `design`'s group on record `r` alone (its evaluator on its window):
+// `expression` is `set weights` on the window as fit.cpp computes it (empty when the model sets none).
+std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, const std::vector<SampledRecord>& records, std::size_t r,
+                                                        Evaluator& evaluator, const DesignBuilder& design,
+                                                        const std::vector<std::size_t>& equations, std::span<const double> expression);
+
+// The weak design of `design`'s group over every record (each evaluator on its record's window),
+// the records' rows stacked; `expression_weights` per record (empty when the model sets none).
+std::variant<WeakDesign, Diagnostic> weak_design(const ir::Model& model, const std::vector<SampledRecord>& records,
+                                                 std::vector<Evaluator>& evaluators, const DesignBuilder& design,
+                                                 const std::vector<std::size_t>& equations,
+                                                 const std::vector<std::vector<double>>& expression_weights);
+
+// One line for the report: "42 subdomains of 2*48+1 samples, phi = (1 - s^2)^6; <reason>".
+std::string describe(const TestFunctionGrid& grid, double step);
+
+}  // namespace sidc

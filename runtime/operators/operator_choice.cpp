@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <map>
 #include <set>
 
 #include "diagnostics/data_catalogue.hpp"
@@ -130,27 +131,42 @@ std::variant<ArcChoice, Diagnostic> choose_arc(std::span<const double> y, double
   best.order = order;
   best.noise_free = noise.sigma == 0;
   double best_mse = -1;
+  // The reference must itself fit the samples of its window to the noise: where even the higher
+  // polynomial cannot follow the signal (a window wider than the signal's own scale), both arcs
+  // flatten it alike and their difference says nothing. So a candidate counts only when the
+  // reference's smoothing residual, y - s*y, has a mean square within three standard errors of
+  // what the noise alone gives it, sigma^2 (1 - s_centre) (s a projection).
+  double largest = 0;  // rounding in the smoothing residual is not misfit
+  for (std::size_t i : positions) largest = std::max(largest, std::abs(y[i]));
+  const double floor = 1e-24 * largest * largest;
   for (const auto& c : candidates) {
     const std::vector<double> arc = stencil(c.window, c.polyorder, order, c.repeated);
     const std::vector<double> reference = stencil(c.window, c.polyorder + 2, order, c.repeated);
     const double variance = sigma2 * sum_of_squares(arc) / (scale * scale);
-    double bias2 = 0;
+    double bias = 0;
     if (!positions.empty()) {
+      const auto smooth = std::get<std::vector<double>>(savitzky_golay_weights({c.window, c.polyorder + 2, 0, -1, 1.0}));
+      const auto fitted = apply_at(smooth, y, positions);
+      double residual = 0;
+      for (std::size_t k = 0; k < positions.size(); ++k) residual += (y[positions[k]] - fitted[k]) * (y[positions[k]] - fitted[k]);
+      residual /= static_cast<double>(positions.size());
+      const double expected = sigma2 * (1 - smooth[smooth.size() / 2]);
+      if (residual > expected * (1 + 3 * std::sqrt(2.0 / static_cast<double>(positions.size()))) + floor) continue;
       const auto a = apply_at(arc, y, positions);
       const auto r = apply_at(reference, y, positions);
       double ms = 0;
       for (std::size_t k = 0; k < a.size(); ++k) ms += (a[k] - r[k]) * (a[k] - r[k]);
       ms /= static_cast<double>(a.size());
-      bias2 = std::max(0.0, ms - sigma2 * distance_squared(arc, reference)) / (scale * scale);
+      bias = std::sqrt(std::max(0.0, ms - sigma2 * distance_squared(arc, reference))) / scale;
     }
-    const double mse = variance + bias2;
+    const double mse = variance + bias * bias;
     if (best_mse < 0 || mse < best_mse) {
       best_mse = mse;
       best.arc = base;
       best.arc.window = c.window;
       best.arc.polyorder = c.polyorder;
       best.arc.second = c.repeated ? DerivativeOptions::Second::repeated : DerivativeOptions::Second::direct;
-      best.bias = std::sqrt(bias2);
+      best.bias = bias;
       best.noise = std::sqrt(variance);
     }
   }

@@ -15,6 +15,7 @@
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "ir/queries.hpp"
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
@@ -70,8 +71,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   const FitSummary& summary = std::get<FitSummary>(result);
   for (const auto& r : summary.operators)
     for (const auto& w : r.warnings) std::cerr << render(w) << "\n";
-  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << operator_report(summary.operators, options->evaluation)
-            << "\n" << summary.full_report(model);
+  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << operator_report(summary.operators, options->evaluation);
+  if (!is_static(model)) std::cout << "\n";
+  std::cout << summary.full_report(model);
 
   std::optional<FitValidation> validation;
   if (!a.no_validate) {

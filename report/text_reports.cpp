@@ -17,6 +17,7 @@ std::string derivative_label(const std::string& signal, int order) {
 std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options) {
   std::string out;
   for (const auto& r : reports) {
+    if (r.noise.empty() && r.arcs.empty()) continue;  // a static model: rows, not a time series
     out += fmt::format("record {}: noise levels (MAD of k-th differences) and derivative operators\n", r.record);
     for (const auto& s : r.noise) {
       const NoiseLevel& n = s.level;

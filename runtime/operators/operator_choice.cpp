@@ -9,6 +9,7 @@
 
 #include "diagnostics/data_catalogue.hpp"
 #include "ir/print.hpp"
+#include "ir/queries.hpp"
 #include "ir/traversal.hpp"
 
 namespace sidc {
@@ -129,8 +130,9 @@ std::variant<ArcChoice, Diagnostic> choose_arc(std::span<const double> y, double
   ArcChoice best;
   best.signal = signal;
   best.order = order;
-  best.noise_free = noise.sigma == 0;
+  best.noise_free = noise.constant;
   double best_mse = -1;
+  if (noise.constant) candidates.clear();  // nothing to weigh: the smallest arc, below
   // The reference must itself fit the samples of its window to the noise: where even the higher
   // polynomial cannot follow the signal (a window wider than the signal's own scale), both arcs
   // flatten it alike and their difference says nothing. So a candidate counts only when the
@@ -225,6 +227,9 @@ std::variant<OperatorReport, Diagnostic> choose_operators(const SampledRecord& r
   report.record = record.path;
   report.automatic = options.automatic_derivative;
   std::map<std::string, NoiseLevel> levels;
+  // A static model's rows are not a time series (Norris' data): differences of neighbouring rows
+  // say nothing about noise, and nothing is differentiated.
+  if (is_static(model) && extra.empty()) return report;
   for (const auto& [name, samples] : record.signals) {
     const NoiseLevel level = estimate_noise_level(samples);
     levels[name] = level;

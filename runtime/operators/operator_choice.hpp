@@ -16,8 +16,9 @@
 //   half-width (d half-widths for a repeated arc) is at most kAutoEdgeShare of the record (the
 //   fit window loses that at each end under `edges = drop`) and at most kAutoMaxWindow; polynomial
 //   orders d, d + 2, d + 4 (orders of the other parity give the same centred weights). Ties go to
-//   the smaller window, then the lower order, so a signal without noise and without curvature (a
-//   constant) gets the smallest arc. Second and higher derivatives: the direct arc of that order
+//   the smaller window, then the lower order; a constant signal gets the smallest arc (window 5,
+//   order d; 7 for d = 3) without weighing. A candidate counts only where its reference fits the
+//   samples of its window to the noise (operator_choice.cpp says why). Second and higher derivatives: the direct arc of that order
 //   (see docs/accuracy.md for the measurement that chose it) unless `second_derivative` is written,
 //   in which case only that way is searched.
 //
@@ -55,7 +56,7 @@ struct ArcChoice {
   DerivativeOptions arc;      // window, polynomial order and the way to higher orders; edges as set
   double bias = 0;            // estimated rms bias over the record, in signal units per time^order
   double noise = 0;           // estimated rms of the noise's share, same units
-  bool noise_free = false;    // the signal's noise level is 0: the smallest arc
+  bool noise_free = false;    // a constant signal (noise 0, no variation): the smallest arc
   double rms_error() const;   // sqrt(bias^2 + noise^2), the criterion's value
   // "savgol(17, 3)", "savgol(9, 3) repeated" for a repeated arc of order >= 2.
   std::string describe() const;
@@ -83,7 +84,8 @@ struct OperatorReport {
   std::vector<Diagnostic> warnings;
 };
 
-// The noise level of every signal of `record` and, when options.automatic_derivative, the arc of
+// The noise level of every signal of `record` (none for a static model, whose rows are not a time
+// series) and, when options.automatic_derivative, the arc of
 // every derivative `model` estimates from it (`extra` adds (signal, order) pairs that something
 // else needs, e.g. validation's initial state). A der() of a sum uses, at its order, the widest arc
 // chosen for the signals inside it (the smoothest; its argument is not a recorded signal).

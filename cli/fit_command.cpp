@@ -15,6 +15,7 @@
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "ir/queries.hpp"
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
@@ -68,7 +69,11 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   auto result = fit(model, records, *options);
   if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
   const FitSummary& summary = std::get<FitSummary>(result);
-  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << summary.full_report(model);
+  for (const auto& r : summary.operators)
+    for (const auto& w : r.warnings) std::cerr << render(w) << "\n";
+  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << operator_report(summary.operators, options->evaluation);
+  if (!is_static(model)) std::cout << "\n";
+  std::cout << summary.full_report(model);
 
   std::optional<FitValidation> validation;
   if (!a.no_validate) {
@@ -82,7 +87,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     std::vector<const SampledRecord*> checked;
     for (const auto& r : records) checked.push_back(&r);
     for (const auto& r : extra) checked.push_back(&r);
-    validation = validate_fit(compiled->normalized, *compiled->explicit_form, summary, checked, records.size(), options->evaluation.derivative,
+    validation = validate_fit(compiled->normalized, *compiled->explicit_form, summary, checked, records.size(), options->evaluation,
                               a.validate_samples);
     if (validation->failed_record)
       return fail(render(cli_diag::cannot_validate(validation->failed_path, *validation->failed_record)), exit_code::user_error);

@@ -55,7 +55,7 @@ std::optional<EvaluationSettings> evaluation_settings(const ir::Model& model, co
     }
     e.derivative = *parsed;
   }
-  if (!a.second_derivative.empty()) e.second_derivative_repeated = a.second_derivative == "repeated";
+  if (!a.second_derivative.empty()) e.second_derivative_repeated = a.second_derivative == "repeated", e.second_derivative_given = true;
   if (!a.edges.empty()) e.shorten_edges = a.edges == "shorten";
   if (!a.integration.empty()) e.trapezoid = a.integration == "trapezoid";
   if (a.from) e.from = a.from;

@@ -119,7 +119,7 @@ int run_select(const SelectArguments& a) {
       return fail(render(cli_diag::simulate_needs_explicit_form(*d)), exit_code::user_error);
     o.simulation_error = [&](std::size_t, const std::vector<ParameterIndex>& subset, const std::vector<double>& values) {
       return simulation_rms_error(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form), subset, values, records,
-                                  o.fit.evaluation.derivative, a.simulate_samples);
+                                  o.fit.evaluation, a.simulate_samples);
     };
   }
 

@@ -218,8 +218,8 @@ int run_simulate(const SimulateArguments& a) {
   std::map<std::string, std::vector<double>> from_record;
   if (record) {
     // The model's derivative settings, all of them, as `sidc fit` reads them.
-    const DerivativeOptions d = evaluation_options(evaluation_settings(model.settings)).derivative;
-    auto estimate = initial_state_from_record(explicit_, *record, d, first);
+    const EvaluationOptions evaluation = evaluation_options(evaluation_settings(model.settings));
+    auto estimate = initial_state_from_record(explicit_, *record, evaluation, first);
     if (auto* diag = std::get_if<Diagnostic>(&estimate)) return fail(render(*diag), exit_code::user_error);
     from_record = std::get<std::map<std::string, std::vector<double>>>(std::move(estimate));
   }

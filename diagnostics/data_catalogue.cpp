@@ -1,6 +1,8 @@
 #include "diagnostics/data_catalogue.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fmt/format.h>
 
 #include "diagnostics/model_catalogue.hpp"
@@ -238,6 +240,35 @@ Diagnostic signal_shorter_than_window(std::size_t samples, int window) {
   d.message = fmt::format("the signal has {} sample{} but the moving arc needs {}", samples, samples == 1 ? "" : "s",
                           window);
   d.hint = "use a longer record or a smaller window";
+  return d;
+}
+
+Diagnostic too_short_for_any_arc(std::string_view path, std::string_view signal, int order, std::size_t samples, int needed) {
+  Diagnostic d;
+  d.code = "data-too-short-for-arc";
+  d.message = fmt::format("`{}` in `{}` has {} sample{}, too few for any moving arc of its derivative {} (savgol(auto) needs at least {})",
+                          signal, path, samples, samples == 1 ? "" : "s", order, needed);
+  d.hint = "record more samples, or write the derivative operator yourself with `set derivative = savgol(window, order)`";
+  return d;
+}
+
+Diagnostic constant_signal(std::string_view path, std::string_view signal) {
+  Diagnostic d;
+  d.severity = Severity::warning;
+  d.code = "data-constant-signal";
+  d.message = fmt::format("`{}` is constant in `{}`: its noise level is 0 and its derivatives are 0; savgol(auto) uses the smallest arc", signal, path);
+  d.hint = "check the column: a constant signal carries no information about the dynamics";
+  return d;
+}
+
+Diagnostic noise_exceeds_variation(std::string_view path, std::string_view signal, double sigma, double spread) {
+  Diagnostic d;
+  d.severity = Severity::warning;
+  d.code = "data-noise-exceeds-variation";
+  d.message = fmt::format("the noise of `{}` in `{}` (estimated sigma {:.4g}) exceeds its variation (standard deviation {:.4g}, "
+                          "{:.4g} of it beyond the noise): its derivatives are mostly noise and the fit will not be reliable",
+                          signal, path, sigma, spread, std::sqrt(std::max(0.0, spread * spread - sigma * sigma)));
+  d.hint = "record the signal with less noise, or over a longer time, or average several records";
   return d;
 }
 

@@ -71,6 +71,13 @@ Diagnostic no_time_column(std::string_view path, int header_row);
 Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int order, std::size_t margin, bool cut_by_window);
 Diagnostic signal_shorter_than_window(std::size_t samples, int window);
 
+// ---- noise levels and savgol(auto) (runtime/operators/operator_choice.cpp) -----------------------
+// Errors: the record has fewer samples than the smallest moving arc for that derivative.
+Diagnostic too_short_for_any_arc(std::string_view path, std::string_view signal, int order, std::size_t samples, int needed);
+// Warnings (severity warning), printed by `sidc fit` and kept in fit.json:
+Diagnostic constant_signal(std::string_view path, std::string_view signal);
+Diagnostic noise_exceeds_variation(std::string_view path, std::string_view signal, double sigma, double spread);
+
 }  // namespace sidc::data_diag
 
 namespace sidc::diag {

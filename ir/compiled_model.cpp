@@ -97,7 +97,10 @@ ordered optional_number(const std::optional<double>& v) { return v ? ordered(*v)
 ordered settings_json(const ir::Settings& raw) {
   const EvaluationSettings e = evaluation_settings(raw);
   ordered j;
-  j["derivative"] = {{"method", "savitzky_golay"}, {"window", e.derivative.window}, {"order", e.derivative.order}};
+  if (e.derivative.automatic)  // chosen per signal and order from each record when fitting
+    j["derivative"] = {{"method", "savitzky_golay"}, {"window", "auto"}, {"order", "auto"}};
+  else
+    j["derivative"] = {{"method", "savitzky_golay"}, {"window", e.derivative.window}, {"order", e.derivative.order}};
   j["second_derivative"] = e.second_derivative_repeated ? "repeated" : "direct";
   j["edges"] = e.shorten_edges ? "shorten" : "drop";
   j["integration"] = e.trapezoid ? "trapezoid" : "simpson";

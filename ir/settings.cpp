@@ -32,6 +32,8 @@ const std::vector<std::string>& setting_keys() {
 
 std::optional<MovingArc> parse_moving_arc(const std::string& text) {
   static const std::regex form(R"(savgol\s*\(\s*(\d{1,4})\s*,\s*(\d{1,3})\s*\))");
+  static const std::regex automatic(R"(savgol\s*\(\s*auto\s*\))");
+  if (std::regex_match(text, automatic)) return MovingArc{7, 3, true};
   std::smatch m;
   if (!std::regex_match(text, m, form)) return std::nullopt;
   MovingArc arc{std::stoi(m[1]), std::stoi(m[2])};
@@ -53,9 +55,12 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
     if (value != "fitted" && value != "initial")
       r.expected = "`fitted` (integration constants become parameters, eq. 2-1.5) or `initial` (taken from the record, eq. 4-2.4)";
   } else if (key == "derivative" || key == "smooth_before_integration") {
-    if (!parse_moving_arc(value) && !(key == "smooth_before_integration" && value == "off"))
+    const auto arc = parse_moving_arc(value);
+    const bool fits = key == "derivative" ? arc.has_value() : (arc && !arc->automatic) || value == "off";
+    if (!fits)
       r.expected = std::string("`savgol(window, order)` with an odd window of at least 3 and an order from 1 to window - 1, "
-                               "e.g. `savgol(7, 3)` (thesis eq. 3-1.7)") + (key == "derivative" ? "" : ", or `off`");
+                               "e.g. `savgol(7, 3)` (thesis eq. 3-1.7)") +
+                   (key == "derivative" ? ", or `savgol(auto)` (chosen from the record, the default)" : ", or `off`");
   } else if (key == "second_derivative") {
     if (value != "repeated" && value != "direct")
       r.expected = "`repeated` (the first-derivative operator applied twice, eq. 3-1.8) or `direct`";
@@ -88,7 +93,7 @@ EvaluationSettings evaluation_settings(const ir::Settings& settings) {
     return it == settings.values.end() ? nullptr : &it->second.text;
   };
   if (auto v = get("derivative")) e.derivative = *parse_moving_arc(*v);
-  if (auto v = get("second_derivative")) e.second_derivative_repeated = *v == "repeated";
+  if (auto v = get("second_derivative")) e.second_derivative_repeated = *v == "repeated", e.second_derivative_given = true;
   if (auto v = get("edges")) e.shorten_edges = *v == "shorten";
   if (auto v = get("integration")) e.trapezoid = *v == "trapezoid";
   if (auto v = get("smooth_before_integration"); v && *v != "off") e.smooth_before_integration = parse_moving_arc(*v);

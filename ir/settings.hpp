@@ -21,15 +21,19 @@ struct SettingCheck {
 SettingCheck check_setting(const std::string& key, const std::string& value);
 const std::vector<std::string>& setting_keys();
 
-// A moving-arc (Savitzky-Golay) operator: polynomial of `order` fitted to `window` points.
+// A moving-arc (Savitzky-Golay) operator: polynomial of `order` fitted to `window` points, or
+// `savgol(auto)`: window and order chosen per signal and derivative order from the record
+// (runtime/operators/operator_choice.hpp; the compiler only records the wish).
 struct MovingArc {
   int window = 7;  // the thesis' 7-point cubic, eqs. 3-1.6 to 3-1.8
   int order = 3;
+  bool automatic = false;
 };
 
 struct EvaluationSettings {
-  MovingArc derivative;
+  MovingArc derivative{7, 3, true};        // `derivative` unset: savgol(auto)
   bool second_derivative_repeated = true;  // eq. 3-1.8: the first-derivative operator applied twice
+  bool second_derivative_given = false;    // written: savgol(auto) keeps to that way
   bool shorten_edges = false;              // thesis: drop points without a full neighbourhood
   bool trapezoid = false;                  // integration rule; Simpson by default (section 3-2)
   std::optional<MovingArc> smooth_before_integration;
@@ -41,7 +45,8 @@ struct EvaluationSettings {
 
 // Typed settings from checked raw values (check_setting has accepted every one).
 EvaluationSettings evaluation_settings(const ir::Settings& settings);
-// Reads `savgol(7, 3)`; nullopt if the text is not of that form with a valid window and order.
+// Reads `savgol(7, 3)` or `savgol(auto)`; nullopt if the text is not of that form with a valid
+// window and order.
 std::optional<MovingArc> parse_moving_arc(const std::string& text);
 
 }  // namespace sidc

@@ -46,7 +46,10 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
   j["model"] = m.name;
   j["compiled_model"] = compiled_path;
   j["source_hash"] = source_hash(c.source->text);
-  j["settings"] = {{"derivative", {{"window", o.evaluation.derivative.window}, {"order", o.evaluation.derivative.polyorder}}},
+  const ordered_json derivative = o.evaluation.automatic_derivative
+                                      ? ordered_json{{"window", "auto"}, {"order", "auto"}}
+                                      : ordered_json{{"window", o.evaluation.derivative.window}, {"order", o.evaluation.derivative.polyorder}};
+  j["settings"] = {{"derivative", derivative},
                    {"second_derivative", o.evaluation.derivative.second == DerivativeOptions::Second::repeated ? "repeated" : "direct"},
                    {"edges", o.evaluation.derivative.edges == DerivativeOptions::Edges::drop ? "drop" : "shorten"},
                    {"integration", o.evaluation.integration.rule == IntegrationOptions::Rule::simpson ? "simpson" : "trapezoid"},
@@ -81,6 +84,24 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
                       {"dependent_operations", dependent}});
   }
   j["groups"] = std::move(groups);
+  ordered_json noise = ordered_json::array();
+  for (const auto& r : s.operators) {
+    ordered_json signals = ordered_json::array();
+    for (const auto& n : r.noise)
+      signals.push_back({{"signal", n.signal}, {"column", n.column}, {"sigma", n.level.sigma}, {"spread", n.level.spread},
+                         {"relative", n.level.relative()}, {"difference_order", n.level.difference_order}, {"constant", n.level.constant},
+                         {"noise_exceeds_variation", n.level.exceeds_variation()}});
+    ordered_json arcs = ordered_json::array();
+    for (const auto& a : r.arcs)
+      arcs.push_back({{"signal", a.signal}, {"order", a.order}, {"window", a.arc.window}, {"polynomial_order", a.arc.polyorder},
+                      {"form", a.order >= 2 && a.arc.second == DerivativeOptions::Second::repeated ? "repeated" : "direct"},
+                      {"estimated_rms_error", a.rms_error()}, {"bias", a.bias}, {"noise", a.noise}, {"noise_free", a.noise_free}});
+    ordered_json warnings = ordered_json::array();
+    for (const auto& w : r.warnings) warnings.push_back({{"code", w.code}, {"message", w.message}});
+    noise.push_back({{"path", r.record}, {"signals", signals}, {"derivative_operators", r.automatic ? arcs : ordered_json(nullptr)},
+                     {"warnings", warnings}});
+  }
+  j["records"] = std::move(noise);
   return j;
 }
 

@@ -14,6 +14,7 @@
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
 #include "report/html_report.hpp"
+#include "runtime/operators/operator_choice.hpp"
 #include "runtime/operators/plot_function.hpp"
 #include "runtime/solve/fitted_values.hpp"
 #include "runtime/records/records.hpp"
@@ -34,8 +35,26 @@ struct WindowValues {
 class WindowEstimates {
  public:
   WindowEstimates(const SampledRecord& record, const ir::Model& model, const FitOptions& options) : record_(record) {
-    auto window = fit_window(record, model, options.evaluation, options.from, options.to);
-    if (auto* w = std::get_if<FitWindow>(&window)) evaluator_ = std::make_unique<Evaluator>(record, model, options.evaluation, *w);
+    // Under savgol(auto), the fit's arcs, and arcs for the first three derivatives of every
+    // signal that the figures may draw beyond the model's own (phase planes, exact derivatives).
+    std::vector<std::pair<std::string, int>> extra;
+    for (const auto& [name, samples] : record.signals)
+      for (int k = 1; k <= 3; ++k) extra.emplace_back(name, k);
+    auto chosen = operators_for_record(options.evaluation, record, model, extra);
+    if (!std::holds_alternative<EvaluationOptions>(chosen)) return;
+    evaluation_ = std::get<EvaluationOptions>(std::move(chosen));
+    auto window = fit_window(record, model, evaluation_, options.from, options.to);
+    if (auto* w = std::get_if<FitWindow>(&window)) evaluator_ = std::make_unique<Evaluator>(record, model, evaluation_, *w);
+  }
+
+  // The arc of the order-th derivative of `signal`, as the figures' captions name it.
+  std::string arc_of(const std::string& signal, int order) const {
+    if (!evaluation_.automatic_derivative) {
+      const auto& d = evaluation_.derivative;
+      return fmt::format("savgol({}, {})", d.window, d.polyorder);
+    }
+    const auto d = derivative_options_for(evaluation_, signal, order);
+    return fmt::format("savgol(auto) = savgol({}, {})", d.window, d.polyorder);
   }
 
   std::optional<WindowValues> of(const std::string& signal, int order) {
@@ -55,6 +74,7 @@ class WindowEstimates {
 
  private:
   const SampledRecord& record_;
+  EvaluationOptions evaluation_;
   std::unique_ptr<Evaluator> evaluator_;  // null when the record has no fit window
 };
 
@@ -164,9 +184,8 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
         at = w->time;
         by_signal[exact.signal].push_back({exact.order, w->values, *truth});
       }
-      const auto& d = c.options.evaluation.derivative;
-      const std::string setting = fmt::format("Delta = {:g}, savgol({}, {})", record.step, d.window, d.polyorder);
       for (const auto& [signal, comparisons] : by_signal) {
+        const std::string setting = fmt::format("Delta = {:g}, {}", record.step, estimates.arc_of(signal, comparisons.front().order));
         Figure f = derivative_error_figure(time, {signal, ""}, at, comparisons, setting);
         f.name += suffix(r);
         figures.push_back({std::move(f)});
@@ -205,10 +224,14 @@ ReportContent report_content(const PictureContext& c) {
   content.model_text = c.compiled.source->text;
   const auto& e = c.options.evaluation;
   content.settings = {
-      {"derivatives", fmt::format("{}-point moving arc of order {} (section 3-1); second derivative {}", e.derivative.window,
-                                  e.derivative.polyorder,
-                                  e.derivative.second == DerivativeOptions::Second::repeated ? "by the first-derivative operator applied twice (eq. 3-1.8)"
-                                                                                             : "directly")},
+      {"derivatives", e.automatic_derivative
+                          ? std::string("savgol(auto): a moving arc (section 3-1) per signal and derivative order, of least estimated "
+                                        "mean-square error (the fit report lists each)")
+                          : fmt::format("{}-point moving arc of order {} (section 3-1); second derivative {}", e.derivative.window,
+                                        e.derivative.polyorder,
+                                        e.derivative.second == DerivativeOptions::Second::repeated
+                                            ? "by the first-derivative operator applied twice (eq. 3-1.8)"
+                                            : "directly")},
       {"edges", e.derivative.edges == DerivativeOptions::Edges::drop ? "samples without a full neighbourhood dropped (the thesis)"
                                                                       : "shortened windows at the edges"},
       {"fit window", fmt::format("{} to {}", c.options.from ? fmt::format("{:g}", *c.options.from) : std::string("the record's start"),

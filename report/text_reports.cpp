@@ -5,6 +5,41 @@
 
 namespace sidc {
 
+namespace {
+
+std::string derivative_label(const std::string& signal, int order) {
+  if (signal.find('(') != std::string::npos) return fmt::format("{} (order {})", signal, order);  // a der() factor
+  return order <= 3 ? signal + std::string(static_cast<std::size_t>(order), '\'') : fmt::format("{}^({})", signal, order);
+}
+
+}  // namespace
+
+std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options) {
+  std::string out;
+  for (const auto& r : reports) {
+    if (r.noise.empty() && r.arcs.empty()) continue;  // a static model: rows, not a time series
+    out += fmt::format("record {}: noise levels (MAD of k-th differences) and derivative operators\n", r.record);
+    for (const auto& s : r.noise) {
+      const NoiseLevel& n = s.level;
+      if (n.constant) out += fmt::format("  {:<10} noise 0 (constant signal)\n", s.signal);
+      else
+        out += fmt::format("  {:<10} noise sigma {:.3g} = {:.3g}% of its spread {:.4g} (differences of order {}){}\n", s.signal, n.sigma,
+                           100 * n.relative(), n.spread, n.difference_order, n.exceeds_variation() ? "  WARNING: noise exceeds variation" : "");
+    }
+    if (!r.automatic) {
+      const auto& d = options.derivative;
+      out += fmt::format("  derivatives: savgol({}, {}) as set; higher orders {}\n", d.window, d.polyorder,
+                         d.second == DerivativeOptions::Second::repeated ? "by the first-derivative arc repeated (eq. 3-1.8)" : "by the direct arc");
+      continue;
+    }
+    for (const auto& a : r.arcs) {
+      out += fmt::format("  {:<10} {}, estimated rms error {:.3g} (bias {:.3g}, noise {:.3g}){}\n", derivative_label(a.signal, a.order) + ":",
+                         a.describe(), a.rms_error(), a.bias, a.noise, a.noise_free ? "; noise 0: the smallest arc" : "");
+    }
+  }
+  return out;
+}
+
 std::string validation_report(const FitValidation& v) {
   std::string out;
   if (!v.note.empty()) out += "\nvalidation: " + v.note + "\n";

@@ -171,7 +171,7 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       const auto found = record_.signals.find(f.name);
       if (found == record_.signals.end()) return diag::signal_not_in_record(where, f.name, record_.path);
       if (f.order == 0) return slice(found->second, r);
-      const auto op = derivative_operator(options_, f.order);
+      const auto op = derivative_operator(options_, f.order, f.name);
       const Range wide = widened(op->reach().value_or(samples));
       const std::span<const double> samples_read(found->second.data() + wide.first, wide.size());
       auto estimate = op->apply(samples_read, record_.step);
@@ -212,7 +212,7 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
       return v;
     }
     case FactorKind::derivative: {
-      const auto op = derivative_operator(options_, f.order);
+      const auto op = derivative_operator(options_, f.order, name_of(f));
       const Range wide = widened(op->reach().value_or(samples));
       auto argument = sum(*f.argument, wide);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;

@@ -60,12 +60,67 @@ int highest_derivative_order(const ir::Model& model) {
   return k;
 }
 
+DerivativeOptions derivative_options_for(const EvaluationOptions& options, const std::string& signal, int order) {
+  if (!options.automatic_derivative || order == 0) return options.derivative;
+  if (auto s = options.chosen.find(signal); s != options.chosen.end())
+    if (auto o = s->second.find(order); o != s->second.end()) return o->second;
+  throw std::logic_error(fmt::format("no moving arc was chosen for derivative {} of `{}` (operators_for_record() not applied)", order, signal));
+}
+
+namespace {
+
+// What one sum loses at each edge under savgol(auto): a derivative its own arc's half-window
+// (its arcs' for a repeated one), a der() that plus what its argument loses already.
+int samples_lost_by(const ir::Sum& s, const EvaluationOptions& options) {
+  int lost = 0;
+  for (const auto& t : s.terms)
+    for (const auto& [f, power] : t.factors) {
+      int here = 0;
+      switch (f.kind) {
+        case FactorKind::signal:
+        case FactorKind::initial_value:
+          if (f.order > 0) here = samples_lost_each_side(f.order, derivative_options_for(options, f.name, f.order));
+          break;
+        case FactorKind::derivative:
+          here = samples_lost_by(*f.argument, options) + samples_lost_each_side(f.order, derivative_options_for(options, print(f), f.order));
+          break;
+        case FactorKind::function:
+        case FactorKind::power:
+        case FactorKind::integral: here = samples_lost_by(*f.argument, options); break;
+        case FactorKind::guard:
+          for (const auto& c : f.conditions) here = std::max({here, samples_lost_by(*c.lhs, options), samples_lost_by(*c.rhs, options)});
+          break;
+        case FactorKind::time:
+        case FactorKind::elapsed:
+        case FactorKind::window_start:
+        case FactorKind::parameter: break;
+      }
+      lost = std::max(lost, here);
+    }
+  return lost;
+}
+
+}  // namespace
+
+int samples_lost_by_model(const ir::Model& model, const EvaluationOptions& options) {
+  if (!options.automatic_derivative) {  // one arc for all: the highest order decides (eq. 4-1.10)
+    const int order = highest_derivative_order(model);
+    return order > 0 ? samples_lost_each_side(order, options.derivative) : 0;
+  }
+  int lost = 0;
+  for (const auto& e : model.equations) {
+    lost = std::max(lost, samples_lost_by(e.known, options));
+    for (const auto& p : e.terms) lost = std::max(lost, samples_lost_by(p.operation, options));
+  }
+  return lost;
+}
+
 std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, const ir::Model& model,
                                                const EvaluationOptions& options, std::optional<double> from,
                                                std::optional<double> to) {
   const std::size_t n = record.time.size();
   const int order = highest_derivative_order(model);
-  const std::size_t margin = order > 0 ? static_cast<std::size_t>(derivative_operator(options, order)->samples_lost_each_side()) : 0;
+  const std::size_t margin = static_cast<std::size_t>(std::max(0, samples_lost_by_model(model, options)));
   FitWindow w;
   w.first = margin;
   w.last = n > margin ? n - 1 - margin : 0;
@@ -93,7 +148,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::strin
     return diag::signal_not_in_record(where, name, record_.path);
   }
   if (order == 0) return derivatives_[key] = found->second;
-  auto estimate = derivative_operator(options_, order)->apply(found->second, record_.step);
+  auto estimate = derivative_operator(options_, order, name)->apply(found->second, record_.step);
   if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
   return derivatives_[key] = std::get<Values>(std::move(estimate));
 }
@@ -168,7 +223,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
       const Values& a = std::get<Values>(argument);
       Values v(n, nan);
       if (f.kind == FactorKind::derivative) {
-        auto estimate = derivative_operator(options_, f.order)->apply(a, record_.step);
+        auto estimate = derivative_operator(options_, f.order, key)->apply(a, record_.step);
         if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
         v = std::get<Values>(std::move(estimate));
       } else {

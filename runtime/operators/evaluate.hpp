@@ -28,9 +28,22 @@ namespace sidc {
 
 // What chooses and configures the operators (derivative_operator(), integral_operator()).
 struct EvaluationOptions {
+  // The moving arc of every derivative; under `automatic_derivative`, its edges and (when
+  // `second_given`) its way to higher orders still hold, and window and order come from `chosen`.
   DerivativeOptions derivative;
+  // `derivative = savgol(auto)`: window and order chosen per signal and per derivative order from
+  // one record's data (runtime/operators/operator_choice.hpp fills `chosen` for a record).
+  bool automatic_derivative = false;
+  bool second_given = false;  // `second_derivative` was written: auto keeps to that way
+  // Signal name (or a printed der() factor) -> derivative order -> the arc for one record.
+  std::map<std::string, std::map<int, DerivativeOptions>> chosen;
   IntegrationOptions integration;
 };
+
+// The arc for the order-th derivative of `signal` (a signal name or a printed der() factor):
+// options.derivative, or under savgol(auto) the one chosen for this record. A missing choice under
+// auto is a bug of the caller (operators_for_record() was not applied): std::logic_error.
+DerivativeOptions derivative_options_for(const EvaluationOptions& options, const std::string& signal, int order);
 
 // The rows a fit uses: [first, last] of the record, with t0 = time[first].
 struct FitWindow {
@@ -42,6 +55,11 @@ struct FitWindow {
 // The highest order of derivative any operation of the model estimates (a der() of a derivative
 // adds up); the fit window keeps clear of the samples such derivatives lose at each edge.
 int highest_derivative_order(const ir::Model& model);
+
+// Samples the model's operations lose at each edge of a record (edges = drop): the half-window of
+// the widest operator, counting a der() of a derivative as the sum of the two. Under savgol(auto)
+// each signal and order has its own arc.
+int samples_lost_by_model(const ir::Model& model, const EvaluationOptions& options);
 
 // One condition of a guard (eq. 4-1.9's regions) sample by sample: where `lhs relation rhs` fails,
 // `guard` becomes 0; where either side is NaN (no value there), NaN. Shared by the whole-record

@@ -7,8 +7,8 @@
 
 namespace sidc {
 
-std::unique_ptr<const SignalOperator> derivative_operator(const EvaluationOptions& options, int order) {
-  return std::make_unique<MovingArcOperator>(order, options.derivative);
+std::unique_ptr<const SignalOperator> derivative_operator(const EvaluationOptions& options, int order, const std::string& signal) {
+  return std::make_unique<MovingArcOperator>(order, derivative_options_for(options, signal, order));
 }
 
 std::unique_ptr<const SignalOperator> integral_operator(const EvaluationOptions& options) {

@@ -55,8 +55,9 @@ class SignalOperator {
   virtual std::variant<std::vector<double>, Diagnostic> apply(std::span<const double> samples, double step) const = 0;
 };
 
-// The operator `options` choose for the order-th derivative (order 0: smoothing).
-std::unique_ptr<const SignalOperator> derivative_operator(const EvaluationOptions& options, int order);
+// The operator `options` choose for the order-th derivative (order 0: smoothing) of `signal` (a
+// signal name or a printed der() factor: under savgol(auto) each has its own arc).
+std::unique_ptr<const SignalOperator> derivative_operator(const EvaluationOptions& options, int order, const std::string& signal);
 
 // The operator `options` choose for the cumulative integral from the first sample it is given.
 std::unique_ptr<const SignalOperator> integral_operator(const EvaluationOptions& options);

@@ -5,6 +5,7 @@
 // sequential_threshold.hpp, forward_regression.hpp. Guarantees: the header's. The rows of one
 // record are built over its fit window as the dense fit builds them, then cut into blocks of time
 // and folded; memory is p x n doubles while one record is evaluated, and O(F p^2) after.
+#include "runtime/operators/operator_choice.hpp"
 #include "runtime/select/select.hpp"
 
 #include <algorithm>
@@ -197,8 +198,12 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
   const int folds = options.folds;
   const int fine = folds >= 2 ? folds * ((10 + folds - 1) / folds) : 10;
   std::vector<FitWindow> windows;
+  std::vector<EvaluationOptions> evaluation;  // per record: under savgol(auto), its own arcs, as fit chooses them
   for (const auto& r : records) {
-    auto w = fit_window(r, model, options.fit.evaluation, options.fit.from, options.fit.to);
+    auto chosen = operators_for_record(options.fit.evaluation, r, model);
+    if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+    evaluation.push_back(std::get<EvaluationOptions>(std::move(chosen)));
+    auto w = fit_window(r, model, evaluation.back(), options.fit.from, options.fit.to);
     if (auto* d = std::get_if<Diagnostic>(&w)) return *d;
     windows.push_back(std::get<FitWindow>(w));
   }
@@ -231,7 +236,7 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     auto weak = is_weak_group(model, members);
     if (auto* d = std::get_if<Diagnostic>(&weak)) return *d;
     for (std::size_t r = 0; r < records.size(); ++r) {
-      Evaluator evaluator(records[r], model, options.fit.evaluation, windows[r]);
+      Evaluator evaluator(records[r], model, evaluation[r], windows[r]);
       std::vector<double> expression;  // eq. 2-1.6 as sidc fit applies it
       if (model.weights) {
         auto values = expression_weights(model, evaluator);
@@ -284,7 +289,7 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     const TriangularSystem full_system = merged(blocks, all, p);
     g.n = full_system.rows;
     g.blocks = static_cast<std::size_t>(fine);
-    if (auto problem = design.too_few_rows(g.n, options.fit.evaluation)) return *problem;
+    if (auto problem = design.too_few_rows(g.n, evaluation.front())) return *problem;
 
     // Kept columns (not dropped), required ones, groups: by name.
     std::vector<int> kept;

@@ -10,6 +10,7 @@
 #include "ir/differentiate.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "diagnostics/model_catalogue.hpp"
+#include "runtime/operators/operator_choice.hpp"
 #include "runtime/operators/point_evaluator.hpp"
 #include "runtime/operators/savitzky_golay.hpp"
 
@@ -465,13 +466,22 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
   return summary;
 }
 
+std::variant<EvaluationOptions, Diagnostic> state_operators_for_record(const ExplicitForm& form, const SampledRecord& record,
+                                                                       const EvaluationOptions& evaluation) {
+  std::vector<std::pair<std::string, int>> needed;
+  for (const auto& out : form.outputs)
+    for (int m = 1; m < out.order; ++m) needed.emplace_back(out.name, m);
+  return operators_for_record(evaluation, record, ir::Model{}, needed);
+}
+
 std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_state_from_record(const ExplicitForm& form,
                                                                                               const SampledRecord& record,
-                                                                                              const DerivativeOptions& derivative,
+                                                                                              const EvaluationOptions& evaluation,
                                                                                               std::size_t index) {
   std::map<std::string, std::vector<double>> initial;
-  DerivativeOptions d = derivative;
-  d.edges = DerivativeOptions::Edges::shorten;
+  auto chosen = state_operators_for_record(form, record, evaluation);
+  if (auto* e = std::get_if<Diagnostic>(&chosen)) return *e;
+  const EvaluationOptions& options = std::get<EvaluationOptions>(chosen);
   for (const auto& out : form.outputs) {
     auto column = record.signals.find(out.name);
     if (column == record.signals.end()) return diag::signal_not_in_record(out.span, out.name, record.path);
@@ -481,6 +491,8 @@ std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_sta
         values.push_back(column->second[index]);
         continue;
       }
+      DerivativeOptions d = derivative_options_for(options, out.name, m);
+      d.edges = DerivativeOptions::Edges::shorten;
       auto estimate = estimate_derivative(column->second, record.step, m, d);
       if (auto* e = std::get_if<Diagnostic>(&estimate)) return *e;
       values.push_back(std::get<std::vector<double>>(estimate)[index]);

@@ -75,10 +75,16 @@ struct SimulationSummary {
 std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options);
 
 // y(t), y'(t), ..., y^(n-1)(t) of each output at sample `index` of a record, derivatives by the
-// moving arc with off-centre (shortened) windows at the edges, so the first sample has them.
+// moving arc with off-centre (shortened) windows at the edges, so the first sample has them;
+// under savgol(auto) the arc chosen for each output and order from this record, as fit chooses it.
 std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_state_from_record(const ExplicitForm& form,
                                                                                               const SampledRecord& record,
-                                                                                              const DerivativeOptions& derivative,
+                                                                                              const EvaluationOptions& evaluation,
                                                                                               std::size_t index);
+
+// `evaluation` with the arcs of the outputs' derivatives below their orders chosen for `record`
+// (operator_choice.hpp; unchanged without savgol(auto)).
+std::variant<EvaluationOptions, Diagnostic> state_operators_for_record(const ExplicitForm& form, const SampledRecord& record,
+                                                                       const EvaluationOptions& evaluation);
 
 }  // namespace sidc

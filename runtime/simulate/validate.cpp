@@ -19,10 +19,14 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   // as the fit's own: an off-centre estimate at the very first sample can be far off on a rounded
   // record (Appendix A: y'(0) = -2.7 at Delta = 0.020 where the truth is 0).
   std::size_t start = 0;
-  DerivativeOptions centred = options.derivative;
-  centred.edges = DerivativeOptions::Edges::drop;
+  auto chosen = state_operators_for_record(form, record, options.evaluation);
+  if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
   for (const auto& out : form.outputs)
-    if (out.order >= 2) start = std::max(start, static_cast<std::size_t>(std::max(0, samples_lost_each_side(out.order - 1, centred))));
+    for (int m = 1; m < out.order; ++m) {
+      DerivativeOptions centred = derivative_options_for(std::get<EvaluationOptions>(chosen), out.name, m);
+      centred.edges = DerivativeOptions::Edges::drop;
+      start = std::max(start, static_cast<std::size_t>(std::max(0, samples_lost_each_side(m, centred))));
+    }
   if (start + 1 >= record.time.size()) start = 0;
   const auto from = static_cast<std::ptrdiff_t>(start);
   const auto to = static_cast<std::ptrdiff_t>(options.max_samples > 0 ? std::min(record.time.size(), start + options.max_samples) : record.time.size());
@@ -42,7 +46,7 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   for (const auto& s : normalized.signals)
     if (s.kind == ir::Signal::Kind::input && !s.definition)
       if (auto it = record.signals.find(s.name); it != record.signals.end()) o.inputs[s.name].assign(it->second.begin() + from, it->second.begin() + to);
-  auto initial = initial_state_from_record(form, record, options.derivative, start);
+  auto initial = initial_state_from_record(form, record, options.evaluation, start);
   if (auto* d = std::get_if<Diagnostic>(&initial)) return *d;
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
 
@@ -123,7 +127,7 @@ std::string ValidationSummary::report(const std::string& method) const {
 }
 
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
-                           const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const DerivativeOptions& derivative,
+                           const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples) {
   FitValidation v;
   v.max_samples = max_samples;
@@ -137,7 +141,7 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   }
   const std::vector<double> parameters = fitted_parameter_values(normalized, summary, 0.0);
   ValidationOptions o;
-  o.derivative = derivative;
+  o.evaluation = evaluation;
   o.max_samples = max_samples;
   for (std::size_t r = 0; r < records.size(); ++r) {
     auto run = validate(normalized, std::get<ExplicitForm>(form), parameters, *records[r], o);
@@ -157,13 +161,13 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
 
 std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<ParameterIndex>& subset,
                                            const std::vector<double>& values, const std::vector<SampledRecord>& records,
-                                           const DerivativeOptions& derivative, std::size_t max_samples) {
+                                           const EvaluationOptions& evaluation, std::size_t max_samples) {
   std::vector<double> parameters(normalized.parameters.size(), 0.0);
   for (std::size_t i = 0; i < subset.size(); ++i)
     // The derivative form's parameters come first in the fitted model's order (integrate_pass.cpp).
     if (!subset[i].record && subset[i].parameter < parameters.size()) parameters[subset[i].parameter] = values[i];
   ValidationOptions v;
-  v.derivative = derivative;
+  v.evaluation = evaluation;
   v.max_samples = max_samples;
   double squares = 0;
   std::size_t count = 0;

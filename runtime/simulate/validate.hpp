@@ -39,7 +39,7 @@ struct ValidationOptions {
   SimulateOptions::Method method = SimulateOptions::Method::rk4;
   int substeps = 4;           // rk4, the thesis' solver: four steps per sample interval
   double tolerance = 1e-9;    // adaptive
-  DerivativeOptions derivative;  // for the initial derivatives (edges are always shortened)
+  EvaluationOptions evaluation;  // the fit's, for the initial derivatives (edges are always shortened)
   // Samples compared at most, from the start (0 = all). A free run costs about 2 us per equation
   // evaluation, 16 per sample: 10^7 samples would take minutes, so sidc fit bounds it.
   std::size_t max_samples = 0;
@@ -85,7 +85,7 @@ struct FitValidation {
 // `records`: the fitted records first (`fitted_records` of them), then those given only to be
 // compared with. `form`: the compiled model's explicit form of `normalized`.
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
-                           const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const DerivativeOptions& derivative,
+                           const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples);
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
@@ -94,6 +94,6 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
 // be compared.
 std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<ParameterIndex>& subset,
                                            const std::vector<double>& values, const std::vector<SampledRecord>& records,
-                                           const DerivativeOptions& derivative, std::size_t max_samples);
+                                           const EvaluationOptions& evaluation, std::size_t max_samples);
 
 }  // namespace sidc

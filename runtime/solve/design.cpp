@@ -126,7 +126,9 @@ const double* DesignBuilder::row_weights(std::size_t record, std::size_t first_s
 std::optional<Diagnostic> DesignBuilder::too_few_rows(std::size_t rows, const EvaluationOptions& options) const {
   if (rows >= columns_.size()) return std::nullopt;
   return diag::window_too_short(records_.front().path, rows, columns_.size(),
-                                samples_lost_each_side(std::max(1, highest_derivative_order(model_)), options.derivative));
+                                options.automatic_derivative
+                                    ? samples_lost_by_model(model_, options)
+                                    : samples_lost_each_side(std::max(1, highest_derivative_order(model_)), options.derivative));
 }
 
 void DesignBuilder::label(LeastSquaresSummary& summary) const {

@@ -20,6 +20,7 @@
 #include "ir/queries.hpp"
 #include "ir/traversal.hpp"
 #include "runtime/operators/block_evaluator.hpp"
+#include "runtime/operators/operator_choice.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 #include "runtime/solve/weak_design.hpp"
 
@@ -81,6 +82,7 @@ struct StreamPlan {
   const std::vector<SampledRecord>& records;
   const std::vector<FitWindow>& windows;
   const FitOptions& options;
+  const std::vector<EvaluationOptions>& evaluation;  // per record: its arcs under savgol(auto)
   const DesignBuilder& design;
   std::vector<WholeWindowValues> whole;  // per record
   std::vector<std::string> guard_texts;  // the group's guards, in count_regions' order
@@ -149,7 +151,7 @@ void stream_rows(const StreamPlan& plan, StreamWorker& worker, std::size_t r, st
   const SampledRecord& record = plan.records[r];
   const FitWindow& w = plan.windows[r];
   const auto p = static_cast<Eigen::Index>(plan.design.columns().size());
-  BlockEvaluator evaluator(record, plan.options.evaluation, w, plan.whole[r]);
+  BlockEvaluator evaluator(record, plan.evaluation[r], w, plan.whole[r]);
   BlockValues values(evaluator, record, w, &worker.problem), guard_values(evaluator, record, w, &worker.guard_problem);
   const std::size_t block_rows = std::max<std::size_t>(plan.options.stream_block_rows, 1);
   std::vector<double> guards(count_regions ? plan.guard_sums.size() * block_rows : 0);
@@ -200,8 +202,9 @@ int stream_thread_count(const FitOptions& options) {
 // The streamed path for one group (FitOptions::stream_above_entries).
 std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector<SampledRecord>& records,
                                        const std::vector<FitWindow>& windows, const FitOptions& options,
-                                       const DesignBuilder& design, std::size_t total_rows, GroupFit& g) {
-  StreamPlan plan{model, records, windows, options, design, {}, {}, {}};
+                                       const std::vector<EvaluationOptions>& evaluation, const DesignBuilder& design,
+                                       std::size_t total_rows, GroupFit& g) {
+  StreamPlan plan{model, records, windows, options, evaluation, design, {}, {}, {}};
   for (const auto& [text, f] : guards_of(model, g.equations)) {
     plan.guard_texts.push_back(text);
     plan.guard_sums.push_back(ir::factor(f));
@@ -210,7 +213,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   for (const auto& s : plan.guard_sums) sums.push_back(&s);
   if (model.weights) sums.push_back(&model.weights->value);
   for (std::size_t r = 0; r < records.size(); ++r) {
-    auto whole = prepare_whole_window_values(records[r], model, options.evaluation, windows[r], sums);
+    auto whole = prepare_whole_window_values(records[r], model, evaluation[r], windows[r], sums);
     if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
     plan.whole.push_back(std::get<WholeWindowValues>(std::move(whole)));
   }
@@ -220,7 +223,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
     const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
     std::vector<double> values(block_rows);
     for (std::size_t r = 0; r < records.size(); ++r) {
-      BlockEvaluator evaluator(records[r], options.evaluation, windows[r], plan.whole[r]);
+      BlockEvaluator evaluator(records[r], evaluation[r], windows[r], plan.whole[r]);
       for (std::size_t start = 0; start < windows[r].size(); start += block_rows) {
         const std::size_t m = std::min(block_rows, windows[r].size() - start), first = windows[r].first + start;
         evaluator.start_block(first, first + m);
@@ -276,7 +279,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
       counts[text.empty() ? "(no guard)" : text] += rows;
     }
   for (auto& [text, rows] : counts) g.regions.push_back({text, rows});
-  if (auto problem = design.too_few_rows(total_rows, options.evaluation)) return problem;
+  if (auto problem = design.too_few_rows(total_rows, evaluation.front())) return problem;
 
   for (std::size_t k = 1; k < workers.size(); ++k) workers[0].accumulator.merge(workers[k].accumulator);
   const auto clock = std::chrono::steady_clock::now();
@@ -364,14 +367,19 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
   FitSummary summary;
   summary.model_name = model.name;
   std::vector<FitWindow> windows;
+  std::vector<EvaluationOptions> evaluation;  // per record: under savgol(auto), its own arcs
   for (const auto& r : records) {
-    auto w = fit_window(r, model, options.evaluation, options.from, options.to);
+    auto chosen = choose_operators(r, model, options.evaluation);
+    if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+    summary.operators.push_back(std::get<OperatorReport>(std::move(chosen)));
+    evaluation.push_back(with_arcs(options.evaluation, summary.operators.back()));
+    auto w = fit_window(r, model, evaluation.back(), options.from, options.to);
     if (auto* d = std::get_if<Diagnostic>(&w)) return *d;
     windows.push_back(std::get<FitWindow>(w));
   }
   std::vector<Evaluator> evaluators;
   evaluators.reserve(records.size());
-  for (std::size_t r = 0; r < records.size(); ++r) evaluators.emplace_back(records[r], model, options.evaluation, windows[r]);
+  for (std::size_t r = 0; r < records.size(); ++r) evaluators.emplace_back(records[r], model, evaluation[r], windows[r]);
 
   for (const auto& members : equation_groups(model)) {
     GroupFit g;
@@ -394,7 +402,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
       continue;
     }
     if (total_rows * g.columns.size() > options.stream_above_entries) {
-      if (auto problem = stream_group(model, records, windows, options, design, total_rows, g)) return *problem;
+      if (auto problem = stream_group(model, records, windows, options, evaluation, design, total_rows, g)) return *problem;
       summary.groups.push_back(std::move(g));
       continue;
     }
@@ -427,7 +435,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     auto regions = count_regions(model, members, evaluators);
     if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
     g.regions = std::get<std::vector<Region>>(std::move(regions));
-    if (auto problem = design.too_few_rows(total_rows, options.evaluation)) return *problem;
+    if (auto problem = design.too_few_rows(total_rows, evaluation.front())) return *problem;
     g.summary = solve_least_squares(A, b, g.columns, g.weighted ? &weights : nullptr, options.least_squares);
     design.label(g.summary);
     summary.groups.push_back(std::move(g));
@@ -461,16 +469,19 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
   Eigen::VectorXd b(static_cast<Eigen::Index>(block_rows));
   std::size_t remaining = max_rows;  // rows per equation still wanted
   for (std::size_t r = 0; r < records.size() && remaining > 0; ++r) {
-    auto window = fit_window(records[r], model, options.evaluation, options.from, options.to);
+    auto chosen = operators_for_record(options.evaluation, records[r], model);
+    if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+    const EvaluationOptions& evaluation = std::get<EvaluationOptions>(chosen);
+    auto window = fit_window(records[r], model, evaluation, options.from, options.to);
     if (auto* d = std::get_if<Diagnostic>(&window)) return *d;
     FitWindow w = std::get<FitWindow>(window);
     // Only the rows wanted are evaluated: the whole-window values (integrals from t0, derivatives
     // of the whole record) of the first rows do not depend on where the window ends.
     if (w.size() > remaining) w.last = w.first + remaining - 1;
     remaining -= w.size();
-    auto whole = prepare_whole_window_values(records[r], model, options.evaluation, w, design.sums());
+    auto whole = prepare_whole_window_values(records[r], model, evaluation, w, design.sums());
     if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
-    BlockEvaluator evaluator(records[r], options.evaluation, w, std::get<WholeWindowValues>(whole));
+    BlockEvaluator evaluator(records[r], evaluation, w, std::get<WholeWindowValues>(whole));
     BlockValues values(evaluator, records[r], w, nullptr);
     for (std::size_t e : g.equations) {
       for (std::size_t start = 0; start < w.size(); start += block_rows) {

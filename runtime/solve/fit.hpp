@@ -26,6 +26,7 @@
 
 #include "ir/ir.hpp"
 #include "runtime/operators/evaluate.hpp"
+#include "runtime/operators/operator_choice.hpp"
 #include "runtime/solve/design.hpp"
 #include "runtime/solve/least_squares.hpp"
 
@@ -89,6 +90,9 @@ struct GroupFit {
 struct FitSummary {
   std::string model_name;
   std::vector<GroupFit> groups;
+  // Per record: every signal's noise level and, under savgol(auto), the arc chosen for each
+  // derivative (operator_choice.hpp), with their warnings.
+  std::vector<OperatorReport> operators;
   bool is_solution_usable() const;
   std::string brief_report() const;
   std::string full_report(const ir::Model& model) const;

@@ -6,6 +6,8 @@ EvaluationOptions evaluation_options(const EvaluationSettings& e) {
   EvaluationOptions o;
   o.derivative.window = e.derivative.window;
   o.derivative.polyorder = e.derivative.order;
+  o.automatic_derivative = e.derivative.automatic;
+  o.second_given = e.second_derivative_given;
   o.derivative.second = e.second_derivative_repeated ? DerivativeOptions::Second::repeated : DerivativeOptions::Second::direct;
   o.derivative.edges = e.shorten_edges ? DerivativeOptions::Edges::shorten : DerivativeOptions::Edges::drop;
   o.integration.rule = e.trapezoid ? IntegrationOptions::Rule::trapezoid : IntegrationOptions::Rule::simpson;

@@ -118,6 +118,34 @@ TEST(StreamedFit, DerivativeFormWithGuardsAndADefinedInput) {
   expect_same_fit(dense, fitted(m, records, streamed(thesis_options(), 5, 8)));
 }
 
+// savgol(auto): each record gets its own arcs (a noisier record no narrower ones); the streamed fit's
+// halos follow them and agree with the dense fit.
+TEST(StreamedFit, AutomaticArcsPerRecordAgreeWithTheDenseFit) {
+  const ir::Model m = compiled_text("auto.sid",
+                                    "model auto_arcs\ninput x = 60*sin(4*pi*t)\noutput y\nparam m, c, k, d\n"
+                                    "m*y'' + c*y' + k*y + d*der(abs(y)) = x\n");
+  std::vector<SampledRecord> records{appendix_a(m), appendix_a(m)};
+  // Deterministic noise of about 0.1% and 1% of y's spread on the two records.
+  for (std::size_t r = 0; r < 2; ++r) {
+    auto& y = records[r].signals.at("y");
+    for (std::size_t i = 0; i < y.size(); ++i) y[i] += (r ? 1e-2 : 1e-3) * std::sin(1e3 * static_cast<double>(i) * (1.0 + 0.37 * static_cast<double>(r)));
+  }
+  FitOptions o;
+  o.evaluation.automatic_derivative = true;
+  const FitSummary dense = fitted(m, records, o);
+  ASSERT_EQ(dense.operators.size(), 2u);
+  ASSERT_EQ(dense.operators[0].arcs.size(), 2u);  // y' and y'' (the compiler writes der(abs(y)) as sign(y)*y')
+  EXPECT_LE(dense.operators[0].arcs[0].arc.window, dense.operators[1].arcs[0].arc.window);
+  // The fit window keeps clear of the widest arc's half-window (edges = drop).
+  int lost = 0;
+  for (const auto& a : dense.operators[0].arcs) lost = std::max(lost, a.arc.window / 2);
+  EXPECT_EQ(dense.groups[0].records[0].first_sample, static_cast<std::size_t>(lost));
+  for (std::size_t block : {1, 7, 300}) {
+    SCOPED_TRACE(block);
+    expect_same_fit(dense, fitted(m, records, streamed(o, block)));
+  }
+}
+
 TEST(StreamedFit, IntegratedFormSeveralRecordsAndEveryOtherSample) {
   const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
   // The Delta = 0.010 record and its every-other-sample Delta = 0.020 version: two records, each

@@ -1,0 +1,87 @@
+// The difference-based noise estimate (see noise_level.hpp).
+#include "runtime/operators/noise_level.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace sidc {
+namespace {
+
+// 1 / Phi^-1(3/4): the MAD of a normal law times this is its standard deviation.
+constexpr double kMadToSigma = 1.482602218505602;
+
+double median_in_place(std::vector<double>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  double m = *mid;
+  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), mid));
+  return m;
+}
+
+// 1.4826 * median |x - median(x)|.
+double robust_scale(std::vector<double> x) {
+  if (x.empty()) return 0;
+  const double centre = median_in_place(x);
+  for (double& v : x) v = std::abs(v - centre);
+  return kMadToSigma * median_in_place(x);
+}
+
+double binomial(int n, int k) {
+  double c = 1;
+  for (int i = 1; i <= k; ++i) c = c * (n - k + i) / i;
+  return c;
+}
+
+// The pieces of the signal the estimate reads: the whole signal, or kChunks evenly spaced
+// contiguous chunks when it is longer than kMaxNoiseSamples.
+std::vector<std::span<const double>> pieces_of(std::span<const double> y) {
+  if (y.size() <= kMaxNoiseSamples) return {y};
+  constexpr std::size_t kChunks = 20;
+  const std::size_t length = kMaxNoiseSamples / kChunks;
+  std::vector<std::span<const double>> out;
+  for (std::size_t c = 0; c < kChunks; ++c) {
+    const std::size_t start = (y.size() - length) * c / (kChunks - 1);
+    out.push_back(y.subspan(start, length));
+  }
+  return out;
+}
+
+}  // namespace
+
+NoiseLevel estimate_noise_level(std::span<const double> y) {
+  NoiseLevel level;
+  level.samples = y.size();
+  if (y.empty()) return level;
+  double mean = 0;
+  for (double v : y) mean += v;
+  mean /= static_cast<double>(y.size());
+  double ss = 0;
+  for (double v : y) ss += (v - mean) * (v - mean);
+  level.spread = std::sqrt(ss / static_cast<double>(y.size()));
+  level.constant = std::all_of(y.begin(), y.end(), [&](double v) { return v == y.front(); });
+  if (level.constant || y.size() < 3) return level;
+
+  const auto pieces = pieces_of(y);
+  std::vector<std::vector<double>> differences;  // per piece, of the current order
+  for (const auto& p : pieces) differences.emplace_back(p.begin(), p.end());
+  double previous = -1;
+  for (int k = 1; k <= kMaxDifferenceOrder; ++k) {
+    std::vector<double> all;
+    for (auto& d : differences) {
+      for (std::size_t i = 0; i + 1 < d.size(); ++i) d[i] = d[i + 1] - d[i];
+      if (!d.empty()) d.pop_back();
+      all.insert(all.end(), d.begin(), d.end());
+    }
+    if (all.size() < 2) break;  // too short for this order: keep the last estimate
+    const double estimate = robust_scale(std::move(all)) / std::sqrt(binomial(2 * k, k));
+    if (previous >= 0 && estimate >= 0.95 * previous) break;  // stopped falling: noise only
+    level.sigma = estimate;
+    level.difference_order = k;
+    previous = estimate;
+    if (estimate == 0) break;  // exactly a polynomial of degree < k
+  }
+  return level;
+}
+
+}  // namespace sidc

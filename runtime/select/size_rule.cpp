@@ -16,10 +16,11 @@ ElbowResult relative_g_elbow(const std::vector<double>& G, double share) {
   if (G.size() < 2) return result;
   // G = 0 (an exact fit) is held at the smallest normal number, so that logs stay finite.
   auto clamp = [](double g) { return std::max(g, std::numeric_limits<double>::min()); };
-  const double floor = clamp(G.back());
+  // Differences of logs, not logs of ratios: G / G_full may overflow when G_full is near 0.
+  const double floor = std::log(clamp(G.back()));
   for (std::size_t k = 1; k < G.size(); ++k) {
-    const double before = std::log(clamp(G[k - 1]) / floor);
-    const double after = std::max(0.0, std::log(clamp(G[k]) / floor));
+    const double before = std::log(clamp(G[k - 1])) - floor;
+    const double after = std::max(0.0, std::log(clamp(G[k])) - floor);
     if (!(before > 0)) continue;
     result.left[k] = after / before;
     if (result.index < 0 && result.left[k] <= share) result.index = static_cast<int>(k);

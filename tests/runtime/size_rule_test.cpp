@@ -34,7 +34,8 @@ TEST(RelativeGElbow, WithoutAnElbowTheLargestSizeIsTaken) {
 }
 
 TEST(RelativeGElbow, ShareAndExactFitsAndShortLists) {
-  EXPECT_EQ(relative_g_elbow({100, 10, 1, 0.5, 0.25}, 0.5).index, 3);
+  EXPECT_EQ(relative_g_elbow({100, 10, 1, 0.5, 0.25}, 0.5).index, 2);  // 10 -> 1 leaves log 4 / log 40 = 0.38
+  EXPECT_EQ(relative_g_elbow({100, 10, 1, 0.5, 0.25}).index, 4);
   EXPECT_EQ(relative_g_elbow({100, 1e-3, 0, 0}).index, 2);  // G = 0 held at the smallest normal number
   EXPECT_EQ(relative_g_elbow({5}).index, -1);
   EXPECT_EQ(relative_g_elbow({}).index, -1);

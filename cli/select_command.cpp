@@ -36,7 +36,8 @@ struct SelectArguments {
   int max_size = -1;
   bool simulate = false;                   // rank the sizes by free-run simulation error too
   std::size_t simulate_samples = 100000;   // per record, as sidc fit --validate-samples
-  std::string rule;  // empty: cv with cross-validation, bic with --folds 0
+  std::string rule = "elbow";
+  bool keep_drift = false;  // search drift absorbers of integrated equations too
   std::string out;
 };
 
@@ -56,8 +57,9 @@ int run_select(const SelectArguments& a) {
   const std::map<std::string, SelectionMethod> methods{
       {"automatic", SelectionMethod::automatic}, {"exact", SelectionMethod::exact}, {"stlsq", SelectionMethod::stlsq}, {"frols", SelectionMethod::frols}};
   o.method = methods.at(a.method);
-  const std::string rule = !a.rule.empty() ? a.rule : a.folds >= 2 ? "cv" : "bic";
-  o.rule = rule == "aic" ? SizeRule::aic : rule == "cv" ? SizeRule::cv : SizeRule::bic;
+  const std::map<std::string, SizeRule> rules{{"aic", SizeRule::aic}, {"bic", SizeRule::bic}, {"cv", SizeRule::cv}, {"elbow", SizeRule::elbow}};
+  o.rule = rules.at(a.rule);
+  o.keep_drift = a.keep_drift;
   o.folds = a.folds;
   o.bootstrap = a.bootstrap;
   o.seed = a.seed;
@@ -127,6 +129,12 @@ int run_select(const SelectArguments& a) {
   if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
   const SelectSummary& summary = std::get<SelectSummary>(result);
   if (!summary.ok()) return fail(render(cli_diag::selection_failed(summary.message)), exit_code::user_error);
+  // Drift absorbers are warnings: on stderr too, where a script looks for them.
+  for (const auto& g : summary.groups)
+    for (const auto& d : g.drift)
+      std::cerr << fmt::format("{}: warning: `{}` is nearly a polynomial in t of degree {} over the window (before integration, a + b t holds {:.4f}% of it): a drift absorber{}\n",
+                               a.model, d.column, d.degree, 100 * d.share,
+                               d.set_aside ? "; set aside before the search (give --keep-drift or --require to search it)" : "");
   std::cout << fmt::format("sidc select: model `{}` ({}), size rule {}\n\n", model.name, a.model, to_string(o.rule)) << summary.report();
   if (!a.out.empty()) {
     auto written = write_select_file(a.out, summary, a.model, o);
@@ -154,7 +162,9 @@ void add_select_command(CLI::App& app, int& exit_status) {
   cmd->add_flag("--simulate", a->simulate, "Also rank the sizes by the RMS error of the best subset's solution against the record (thesis section 2-4)");
   cmd->add_option("--simulate-samples", a->simulate_samples, "Samples of each record compared by --simulate at most (0 = all)");
   cmd->add_option("--max-size", a->max_size, "Largest subset size reported")->check(CLI::Range(0, 10000));
-  cmd->add_option("--rule", a->rule, "Criterion naming the non-contributory operations: cv (default), bic (default with --folds 0) or aic")->check(CLI::IsMember({"aic", "bic", "cv"}));
+  cmd->add_option("--rule", a->rule, "Criterion naming the non-contributory operations: elbow (default: the relative-G elbow, or CV's choice when smaller), cv, bic or aic")
+      ->check(CLI::IsMember({"elbow", "aic", "bic", "cv"}));
+  cmd->add_flag("--keep-drift", a->keep_drift, "Search candidates that are nearly a polynomial in t (drift absorbers) in integrated equations too");
   cmd->add_option("--out", a->out, "Directory for select.json");
   cmd->callback([a, &exit_status] { exit_status = run_select(*a); });
 }

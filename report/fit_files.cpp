@@ -199,7 +199,8 @@ nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& mo
   j["model"] = s.model_name;
   j["model_file"] = model_path;
   j["settings"] = {{"method", to_string(o.method)}, {"folds", o.folds}, {"bootstrap", o.bootstrap}, {"seed", o.seed},
-                   {"max_size", o.max_size}, {"rule", to_string(o.rule)}, {"tolerance", o.tolerance},
+                   {"max_size", o.max_size}, {"rule", to_string(o.rule)}, {"elbow_share", o.elbow_share}, {"drift_share", o.drift_share},
+                   {"keep_drift", o.keep_drift}, {"tolerance", o.tolerance},
                    {"required", o.required}, {"dropped", o.dropped}};
   ordered_json groups = ordered_json::array();
   for (const auto& g : s.groups) {
@@ -208,6 +209,7 @@ nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& mo
       ordered_json values = ordered_json::object();
       for (std::size_t k = 0; k < r.parameters.size(); ++k) values[r.parameters[k]] = r.values[k];
       rows.push_back({{"size", r.size}, {"parameters", values}, {"rank", r.rank}, {"G", r.G}, {"standard_error", r.standard_error},
+                      {"elbow_left", std::isfinite(r.elbow_left) ? ordered_json(r.elbow_left) : ordered_json(nullptr)},
                       {"aic", r.aic}, {"bic", r.bic}, {"cv", std::isfinite(r.cv) ? ordered_json(r.cv) : ordered_json(nullptr)},
                       {"cv_standard_error", std::isfinite(r.cv) ? ordered_json(r.cv_standard_error) : ordered_json(nullptr)},
                       {"simulation", r.simulation ? ordered_json(*r.simulation) : ordered_json(nullptr)}});
@@ -217,14 +219,17 @@ nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& mo
     for (std::size_t c = 0; c < g.columns.size(); ++c) operations[g.columns[c]] = g.operations[c];
     ordered_json frequency = ordered_json::object();
     for (std::size_t c = 0; c < g.bootstrap_frequency.size(); ++c) frequency[g.columns[c]] = g.bootstrap_frequency[c];
+    ordered_json drift = ordered_json::array();
+    for (const auto& d : g.drift) drift.push_back({{"column", d.column}, {"share", d.share}, {"degree", d.degree}, {"set_aside", d.set_aside}});
     std::vector<std::size_t> equations;
     for (std::size_t e : g.equations) equations.push_back(e + 1);
     groups.push_back({{"equations", equations}, {"n", g.n}, {"operations", operations}, {"required", g.required}, {"dropped", g.dropped},
                       {"method", to_string(g.method)}, {"subsets_evaluated", g.nodes}, {"subsets_total", g.subsets_total},
                       {"search_seconds", g.search_seconds}, {"path", g.path}, {"sizes", rows},
-                      {"best_size", {{"aic", size_at(g.best_aic)}, {"bic", size_at(g.best_bic)}, {"cv", size_at(g.best_cv)}, {"least_cv", size_at(g.least_cv)},
+                      {"drift_absorbers", drift},
+                      {"best_size", {{"elbow", size_at(g.best_elbow)}, {"aic", size_at(g.best_aic)}, {"bic", size_at(g.best_bic)}, {"cv", size_at(g.best_cv)}, {"least_cv", size_at(g.least_cv)},
                                         {"simulation", size_at(g.best_simulation)}}},
-                      {"chosen_size", size_at(g.chosen)}, {"non_contributory", g.non_contributory},
+                      {"chosen_size", size_at(g.chosen)}, {"reason", g.reason}, {"non_contributory", g.non_contributory},
                       {"bootstrap", {{"replicates", g.bootstrap_replicates}, {"blocks", g.blocks}, {"frequency", frequency}}}});
   }
   j["groups"] = std::move(groups);

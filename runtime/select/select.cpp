@@ -127,9 +127,20 @@ int argmin(const std::vector<SizeRow>& rows, double (*value)(const SizeRow&)) {
   return best;
 }
 
-// The size a rule picks from per-size G on n rows (for bootstrap replicates; cv uses `cv_size`).
-int size_by_rule(const std::vector<std::vector<SubsetFit>>& best, double n, SizeRule rule, int cv_size) {
+// The size a rule picks from per-size G on n rows (for bootstrap replicates; cv uses `cv_size`,
+// the size CV chose on all rows, -1 when cross-validation is off).
+int size_by_rule(const std::vector<std::vector<SubsetFit>>& best, double n, SizeRule rule, int cv_size, double elbow_share) {
   if (rule == SizeRule::cv) return cv_size;
+  if (rule == SizeRule::elbow) {
+    std::vector<double> G;
+    std::vector<int> sizes;
+    for (std::size_t k = 0; k < best.size(); ++k)
+      if (!best[k].empty()) G.push_back(best[k].front().G), sizes.push_back(static_cast<int>(k));
+    const ElbowResult elbow = relative_g_elbow(G, elbow_share);
+    if (elbow.index < 0) return cv_size;
+    const int size = sizes[static_cast<std::size_t>(elbow.index)];
+    return cv_size >= 0 ? std::min(size, cv_size) : size;
+  }
   int pick = -1;
   double value = INFINITY;
   for (std::size_t k = 0; k < best.size(); ++k) {
@@ -164,6 +175,7 @@ const char* to_string(SizeRule rule) {
     case SizeRule::aic: return "AIC";
     case SizeRule::bic: return "BIC";
     case SizeRule::cv: return "CV";
+    case SizeRule::elbow: return "elbow";
   }
   return "?";
 }
@@ -179,6 +191,8 @@ bool SelectOptions::is_valid(std::string* why) const {
   if (bootstrap < 0) return fail(fmt::format("--bootstrap must be >= 0, not {}", bootstrap));
   if (rule == SizeRule::cv && folds == 0) return fail("the size rule `cv` needs cross-validation: give --folds K with K >= 2");
   if (!(tolerance >= 0)) return fail("the tolerance must be >= 0");
+  if (!(elbow_share > 0 && elbow_share < 1)) return fail(fmt::format("the elbow share must be between 0 and 1, not {}", elbow_share));
+  if (!(drift_share > 0 && drift_share <= 1)) return fail(fmt::format("the drift share must be in (0, 1], not {}", drift_share));
   return true;
 }
 
@@ -195,6 +209,7 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
   summary.model_name = model.name;
   summary.rule = options.rule;
   summary.folds = options.folds;
+  summary.elbow_share = options.elbow_share;
   const int folds = options.folds;
   const int fine = folds >= 2 ? folds * ((10 + folds - 1) / folds) : 10;
   std::vector<FitWindow> windows;
@@ -229,6 +244,11 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
       g.operations.push_back(operation);
     }
     const auto p = static_cast<int>(g.columns.size());
+    // Drift test (size_rule.hpp): per column, the least polynomial share over the records and
+    // equations where the operation occurs, and whether one of those equations is integrated.
+    std::vector<double> drift_share(static_cast<std::size_t>(p), kNaN);
+    std::vector<int> drift_degree(static_cast<std::size_t>(p), 0);
+    std::vector<char> integrated(static_cast<std::size_t>(p), 0);
 
     // Rows, folded into `fine` contiguous blocks of time per record (block b of every record
     // goes to triangle b).
@@ -259,6 +279,17 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
         b.resize(static_cast<Eigen::Index>(W * E));
         weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(W * E));
         if (auto problem = design.window_rows(r, evaluator, expression, A, b, weights, 0)) return *problem;
+        // The drift test reads sample rows; the weak form's subdomain rows do not drift.
+        for (std::size_t k = 0; k < E; ++k) {
+          const int integrations = model.equations[members[k]].integrations;
+          const std::vector<double> share =
+              operation_line_share(A.middleRows(static_cast<Eigen::Index>(k * W), static_cast<Eigen::Index>(W)), integrations);
+          for (std::size_t c = 0; c < share.size(); ++c) {
+            if (std::isnan(share[c])) continue;
+            if (std::isnan(drift_share[c]) || share[c] < drift_share[c]) drift_share[c] = share[c], drift_degree[c] = integrations + 1;
+            if (integrations > 0) integrated[c] = 1;
+          }
+        }
       }
       const bool weighted = !records[r].weights.empty() || !expression.empty();
       for (int block = 0; block < fine; ++block) {
@@ -291,19 +322,29 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     g.blocks = static_cast<std::size_t>(fine);
     if (auto problem = design.too_few_rows(g.n, evaluation.front())) return *problem;
 
-    // Kept columns (not dropped), required ones, groups: by name.
+    // Kept columns (not dropped, not drift absorbers set aside), required ones, groups: by name.
+    auto named = [](const std::vector<std::string>& list, const std::string& name) { return std::find(list.begin(), list.end(), name) != list.end(); };
+    auto grouped = [&](const std::string& name) {
+      return std::any_of(options.groups.begin(), options.groups.end(), [&](const auto& group) { return named(group.second, name); });
+    };
     std::vector<int> kept;
     std::vector<char> required(static_cast<std::size_t>(p), 0);
     for (int c = 0; c < p; ++c) {
-      const std::string& name = base_name[static_cast<std::size_t>(c)];
-      if (std::find(options.dropped.begin(), options.dropped.end(), name) != options.dropped.end()) {
-        g.dropped.push_back(g.columns[static_cast<std::size_t>(c)]);
+      const auto u = static_cast<std::size_t>(c);
+      const std::string& name = base_name[u];
+      if (named(options.dropped, name)) {
+        g.dropped.push_back(g.columns[u]);
         continue;
       }
+      const bool is_required = constant[u] || named(options.required, name);
+      if (!constant[u] && drift_share[u] >= options.drift_share) {
+        // A group's member is only flagged: the group may hold the system's operations.
+        const bool set_aside = integrated[u] && !is_required && !options.keep_drift && !grouped(name);
+        g.drift.push_back({g.columns[u], drift_share[u], drift_degree[u], set_aside});
+        if (set_aside) continue;
+      }
       kept.push_back(c);
-      if (constant[static_cast<std::size_t>(c)] ||
-          std::find(options.required.begin(), options.required.end(), name) != options.required.end())
-        required[static_cast<std::size_t>(c)] = 1;
+      if (is_required) required[u] = 1;
     }
     Structure structure;
     std::vector<std::string> kept_names;
@@ -437,7 +478,53 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
         if (g.rows[i].cv <= least.cv + least.cv_standard_error) g.best_cv = static_cast<int>(i);
     }
     g.best_simulation = argmin(g.rows, [](const SizeRow& r) { return r.simulation.value_or(kNaN); });
-    g.chosen = options.rule == SizeRule::aic ? g.best_aic : options.rule == SizeRule::bic ? g.best_bic : g.best_cv;
+    {
+      std::vector<double> G;
+      for (const auto& row : g.rows) G.push_back(row.G);
+      const ElbowResult elbow = relative_g_elbow(G, options.elbow_share);
+      for (std::size_t i = 0; i < g.rows.size(); ++i) g.rows[i].elbow_left = elbow.left[i];
+      g.best_elbow = elbow.index;
+    }
+    auto size_at = [&](int index) { return g.rows[static_cast<std::size_t>(index)].size; };
+    switch (options.rule) {
+      case SizeRule::aic:
+        g.chosen = g.best_aic;
+        if (g.chosen >= 0) g.reason = fmt::format("the least AIC ({:.4f})", g.rows[static_cast<std::size_t>(g.chosen)].aic);
+        break;
+      case SizeRule::bic:
+        g.chosen = g.best_bic;
+        if (g.chosen >= 0) g.reason = fmt::format("the least BIC ({:.4f})", g.rows[static_cast<std::size_t>(g.chosen)].bic);
+        break;
+      case SizeRule::cv:
+        g.chosen = g.best_cv;
+        if (g.chosen >= 0)
+          g.reason = fmt::format("the smallest size whose CV is within one standard error of the least CV (k = {})", size_at(g.least_cv));
+        break;
+      case SizeRule::elbow: {
+        g.chosen = g.best_elbow;
+        if (g.chosen < 0) {
+          g.chosen = g.best_cv;
+          break;
+        }
+        const SizeRow& at = g.rows[static_cast<std::size_t>(g.chosen)];
+        const std::string elbow_words =
+            g.rows.size() == 1 ? fmt::format("the elbow is k = {}, the only size", at.size)
+            : g.chosen + 1 == static_cast<int>(g.rows.size())
+                ? fmt::format("no step before the largest size leaves at most {:.3g}% of log(G/G_full): the elbow is k = {}",
+                              100 * options.elbow_share, at.size)
+                : fmt::format("the step from k = {} to k = {} leaves {:.3g}% of log(G/G_full), at most {:.3g}%: the elbow is k = {}",
+                              size_at(g.chosen - 1), at.size, 100 * at.elbow_left, 100 * options.elbow_share, at.size);
+        if (g.best_cv >= 0 && g.best_cv < g.chosen) {
+          g.reason = fmt::format("{}; CV's choice, k = {}, is smaller and is taken", elbow_words, size_at(g.best_cv));
+          g.chosen = g.best_cv;
+        } else if (g.best_cv >= 0) {
+          g.reason = fmt::format("{}; CV's choice, k = {}, is not smaller", elbow_words, size_at(g.best_cv));
+        } else {
+          g.reason = elbow_words;
+        }
+        break;
+      }
+    }
     if (g.chosen >= 0) {
       const auto& chosen = g.rows[static_cast<std::size_t>(g.chosen)].indices;
       for (int c : kept)
@@ -450,13 +537,13 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
       std::mt19937_64 generator(options.seed + summary.groups.size());
       std::uniform_int_distribution<std::size_t> pick(0, static_cast<std::size_t>(fine) - 1);
       std::vector<int> count(static_cast<std::size_t>(p), 0);
-      const int cv_size = g.rows[static_cast<std::size_t>(g.chosen)].size;
+      const int cv_size = g.best_cv >= 0 ? g.rows[static_cast<std::size_t>(g.best_cv)].size : -1;
       for (int replicate = 0; replicate < options.bootstrap; ++replicate) {
         std::vector<std::size_t> drawn(static_cast<std::size_t>(fine));
         for (auto& d : drawn) d = pick(generator);
         const TriangularSystem resampled = kept_system(merged(blocks, drawn, p));
         const SearchResult r = search(resampled, structure, method, options.max_size, options.tolerance, kept_names);
-        const int k = size_by_rule(r.best, static_cast<double>(resampled.rows), options.rule, cv_size);
+        const int k = size_by_rule(r.best, static_cast<double>(resampled.rows), options.rule, cv_size, options.elbow_share);
         if (k < 0 || static_cast<std::size_t>(k) >= r.best.size() || r.best[static_cast<std::size_t>(k)].empty()) continue;
         for (int c : r.best[static_cast<std::size_t>(k)].front().columns) ++count[static_cast<std::size_t>(kept[static_cast<std::size_t>(c)])];
         ++g.bootstrap_replicates;
@@ -491,6 +578,12 @@ std::string SelectSummary::report() const {
       for (const auto& r : g.dropped) names += (names.empty() ? "" : ", ") + r;
       out += "  dropped before the search: " + names + "\n";
     }
+    for (const DriftAbsorber& d : g.drift)
+      out += fmt::format("  warning: `{}` is nearly a polynomial in t of degree {} over the window (before integration, a + b t holds {:.4f}% of it):\n"
+                         "  a drift absorber, {}\n",
+                         d.column, d.degree, 100 * d.share,
+                         d.set_aside ? "set aside before the search (its coefficient would measure the integrated form's drift; --keep-drift or --require keeps it)"
+                                     : "kept in the search");
     out += "  operations:\n";
     for (std::size_t c = 0; c < g.columns.size(); ++c) out += fmt::format("    {:<10} {}\n", g.columns[c], g.operations[c]);
     if (g.method == SelectionMethod::exact)
@@ -503,8 +596,8 @@ std::string SelectSummary::report() const {
                          g.search_seconds);
     for (const auto& line : g.path) out += "    " + line + "\n";
     const bool has_cv = folds >= 2, has_sim = std::any_of(g.rows.begin(), g.rows.end(), [](const SizeRow& r) { return r.simulation.has_value(); });
-    out += fmt::format("  {:>3}  {:<44} {:>5} {:>13} {:>10} {:>10} {:>10}", "k", "operations of the best subset (thesis Table 4-1.2)", "n",
-                       "G(a)", "std. err", "AIC", "BIC");
+    out += fmt::format("  {:>3}  {:<44} {:>5} {:>13} {:>10} {:>9} {:>10} {:>10}", "k", "operations of the best subset (thesis Table 4-1.2)", "n",
+                       "G(a)", "std. err", "left", "AIC", "BIC");
     if (has_cv) out += fmt::format(" {:>11}", fmt::format("CV({})", folds));
     if (has_sim) out += fmt::format(" {:>11}", "sim");
     out += "\n";
@@ -526,25 +619,29 @@ std::string SelectSummary::report() const {
         start = end + (end < names.size() && names[end] == ' ' ? 1 : 0);
       }
       std::string marks;
+      if (static_cast<int>(i) == g.best_elbow) marks += " <elbow";
       if (static_cast<int>(i) == g.best_aic) marks += " <AIC";
       if (static_cast<int>(i) == g.best_bic) marks += " <BIC";
       if (static_cast<int>(i) == g.best_cv) marks += " <CV";
       if (static_cast<int>(i) == g.least_cv && g.least_cv != g.best_cv) marks += " (least CV)";
       if (static_cast<int>(i) == g.best_simulation) marks += " <sim";
       if (r.rank < r.size) marks += fmt::format(" (rank {})", r.rank);
-      out += fmt::format("  {:>3}  {:<44} {:>5} {:>13.6g} {:>10.4g} {:>10.4f} {:>10.4f}", r.size, lines.front(), g.n, r.G, r.standard_error, r.aic,
-                         r.bic);
+      out += fmt::format("  {:>3}  {:<44} {:>5} {:>13.6g} {:>10.4g} {:>9} {:>10.4f} {:>10.4f}", r.size, lines.front(), g.n, r.G, r.standard_error,
+                         std::isfinite(r.elbow_left) ? fmt::format("{:.3g}", r.elbow_left) : std::string("-"), r.aic, r.bic);
       if (has_cv) out += std::isfinite(r.cv) ? fmt::format(" {:>11.5g}", r.cv) : fmt::format(" {:>11}", "-");
       if (has_sim) out += r.simulation ? fmt::format(" {:>11.5g}", *r.simulation) : fmt::format(" {:>11}", "-");
       out += marks + "\n";
       for (std::size_t l = 1; l < lines.size(); ++l) out += fmt::format("  {:>3}  {}\n", "", lines[l]);
     }
+    out += fmt::format("  left: the share of log(G/G_full) that remains after the step to this size (G_full: every candidate in);\n"
+                       "  <elbow marks the first step that leaves at most {:.3g}\n", elbow_share);
     if (has_cv)
       out += fmt::format("  CV({}): mean squared error per row of held-out contiguous time blocks ({} folds); <CV marks the smallest size\n"
                          "  within one standard error of the least CV\n", folds, folds);
     if (g.chosen >= 0) {
       const SizeRow& r = g.rows[static_cast<std::size_t>(g.chosen)];
       out += fmt::format("  chosen by {}: k = {}\n", to_string(rule), r.size);
+      if (!g.reason.empty()) out += "  why: " + g.reason + "\n";
       for (std::size_t j = 0; j < r.parameters.size(); ++j) out += fmt::format("    {:<10} = {:>15.7g}\n", r.parameters[j], r.values[j]);
       std::string names;
       for (const auto& c : g.non_contributory) names += (names.empty() ? "" : ", ") + c;

@@ -68,10 +68,10 @@ fs::path clean_record() {
   return path;
 }
 
-// The clean record with Gaussian noise of s.d. `sigma` added to y (seeded: the same every run).
-fs::path noisy_record(double sigma) {
-  std::ifstream in(clean_record());
- const fs::path path = work() / ("noisy_" + std::to_string(sigma) + ".csv");
+// A clean record with Gaussian noise of s.d. `sigma` added to y (seeded: the same every run).
+fs::path noisy_record(double sigma, const fs::path& clean = clean_record()) {
+  std::ifstream in(clean);
+  const fs::path path = work() / ("noisy_" + clean.stem().string() + "_" + std::to_string(sigma) + ".csv");
   std::ofstream out(path);
   std::mt19937 generator(2024);
   std::normal_distribution<double> normal(0.0, sigma);
@@ -85,10 +85,21 @@ fs::path noisy_record(double sigma) {
   return path;
 }
 
+// A noise-free record of another truth model of this folder (RK4, 10 substeps per 0.01 s sample).
+fs::path simulated_record(const std::string& truth, const std::string& parameters, const std::string& initial, double t1) {
+  const fs::path csv = work() / (fs::path(truth).stem().string() + ".csv");
+  const SidcRun r = run_sidc("simulate " + shell_quoted(kModels / truth) + " " + parameters + " --t0 0 --t1 " + std::to_string(t1) +
+                             " --step 0.01 --initial " + initial + " --substeps 10 -o " + shell_quoted(csv));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return csv;
+}
+
+SidcRun last_select;  // the last run of select_json, for its stdout and stderr
+
 nlohmann::json select_json(const std::string& model, const fs::path& record, const std::string& options) {
   const fs::path out = work() / "out";
   fs::remove_all(out);
-  const SidcRun r = run_sidc("select " + shell_quoted(kModels / model) + " --data " + shell_quoted(record) + " --out " + shell_quoted(out) + " " +
+  const SidcRun r = last_select = run_sidc("select " + shell_quoted(kModels / model) + " --data " + shell_quoted(record) + " --out " + shell_quoted(out) + " " +
                          options);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("non-contributory operations"), std::string::npos) << r.out;
@@ -120,7 +131,7 @@ TEST(SelectBinary, IntegratedFormWithoutNoiseFindsTheTrueOperations) {
   EXPECT_EQ(chosen(j), kTrueIntegrated);
   EXPECT_EQ(non_contributory(j), kFalse);
   EXPECT_EQ(j["groups"][0]["method"], "exact");
-  EXPECT_EQ(j["settings"]["rule"], "CV");
+  EXPECT_EQ(j["settings"]["rule"], "elbow");
 }
 
 TEST(SelectBinary, IntegratedFormWithSmallNoiseFindsTheTrueOperationsByEveryCriterion) {
@@ -208,6 +219,62 @@ TEST(SelectBinary, LargeNoiseInTheDerivativeFormIsNotRecoveredByBicButByBlockCro
   ASSERT_FALSE(j.is_discarded());
   EXPECT_NE(chosen(j, "bic"), (std::set<std::string>{"m", "c1", "k1", "k3"}));
   EXPECT_EQ(chosen(j, "cv"), (std::set<std::string>{"m", "c1", "k1", "k3"}));
+  EXPECT_EQ(chosen(j), (std::set<std::string>{"m", "c1", "k1", "k3"}));  // the default rule too
+}
+
+TEST(SelectBinary, NoiseFreeRecordWhereCvOverfitsTheElbowFindsTheTrueOperations) {
+  // Van der Pol, integrated twice, no noise: G falls 15 orders of magnitude at the true six
+  // parameters, then a few per cent per extra term fitted to the operators' smooth error, which
+  // every held-out block shares: CV, AIC and BIC keep extra terms, the elbow stops.
+  const fs::path clean = simulated_record("truth_vanderpol.sid", "--param m=1 --param c=-1 --param d=1 --param k=1", "y=1 \"y'=0\"", 40);
+  const auto j = select_json("candidates_vanderpol.sid", clean, "--require m");
+  ASSERT_FALSE(j.is_discarded());
+  const std::set<std::string> truth{"m", "c", "d", "k", "C1", "C2"};
+  EXPECT_EQ(chosen(j), truth);
+  EXPECT_EQ(chosen(j, "elbow"), truth);
+  EXPECT_NE(chosen(j, "cv"), truth);
+  EXPECT_NE(chosen(j, "bic"), truth);
+  EXPECT_NE(j["groups"][0]["reason"].get<std::string>().find("the elbow is k = 6"), std::string::npos) << j["groups"][0]["reason"];
+  // The table shows each size's share left and why the size was chosen.
+  EXPECT_NE(last_select.out.find("<elbow"), std::string::npos) << last_select.out;
+  EXPECT_NE(last_select.out.find("why: the step from k = 5 to k = 6 leaves"), std::string::npos) << last_select.out;
+  // The old default is still there on request.
+  const auto cv = select_json("candidates_vanderpol.sid", clean, "--require m --rule cv");
+  EXPECT_EQ(cv["settings"]["rule"], "CV");
+  EXPECT_EQ(chosen(cv), chosen(j, "cv"));
+}
+
+TEST(SelectBinary, DriftAbsorberIsFlaggedAndSetAside) {
+  // A pendulum within 0.35 rad, integrated twice: cos(y) is nearly 1, so int(int(cos(y))) is
+  // nearly t^2/2 and can absorb the drift of the doubly integrated noise.
+  const fs::path clean = simulated_record("truth_pendulum.sid", "--param J=1 --param c=0.1 --param g=4", "y=0.3 \"y'=0\"", 40);
+  const auto j = select_json("candidates_pendulum.sid", noisy_record(1e-3, clean), "--require J");
+  ASSERT_FALSE(j.is_discarded());
+  const auto& g = j["groups"][0];
+  ASSERT_EQ(g["drift_absorbers"].size(), 1u) << g["drift_absorbers"];
+  EXPECT_EQ(g["drift_absorbers"][0]["column"], "a");
+  EXPECT_EQ(g["drift_absorbers"][0]["degree"], 3);
+  EXPECT_TRUE(g["drift_absorbers"][0]["set_aside"].get<bool>());
+  EXPECT_GT(g["drift_absorbers"][0]["share"].get<double>(), 0.999);
+  EXPECT_NE(last_select.err.find("warning: `a` is nearly a polynomial in t of degree 3"), std::string::npos) << last_select.err;
+  EXPECT_NE(last_select.out.find("warning: `a` is nearly a polynomial in t"), std::string::npos) << last_select.out;
+  EXPECT_EQ(chosen(j), (std::set<std::string>{"J", "c", "g", "C1", "C2"}));
+  for (const auto& row : g["sizes"]) EXPECT_FALSE(row["parameters"].contains("a")) << row.dump();
+  // --keep-drift searches it (and still warns); so does --require.
+  const auto kept = select_json("candidates_pendulum.sid", noisy_record(1e-3, clean), "--require J --keep-drift");
+  EXPECT_FALSE(kept["groups"][0]["drift_absorbers"][0]["set_aside"].get<bool>());
+  bool searched = false;
+  for (const auto& row : kept["groups"][0]["sizes"]) searched = searched || row["parameters"].contains("a");
+  EXPECT_TRUE(searched);
+  EXPECT_NE(last_select.err.find("warning: `a`"), std::string::npos) << last_select.err;
+}
+
+TEST(SelectBinary, TrueOperationsAreNotTakenForDriftAbsorbers) {
+  // Integrated once, the Duffing record's even powers (y'^2, y^2) have a mean and integrate to
+  // near-ramps, but before integration they are far from a line: nothing is flagged.
+  const auto j = select_json("candidates_integrated.sid", noisy_record(1e-3), "--require m");
+  ASSERT_FALSE(j.is_discarded());
+  EXPECT_TRUE(j["groups"][0]["drift_absorbers"].empty()) << j["groups"][0]["drift_absorbers"];
 }
 
 TEST(SelectBinary, HeuristicMethodsFindTheTrueOperationsToo) {
@@ -276,10 +343,12 @@ TEST(SelectBinary, BadOptionsAreUsageErrors) {
     EXPECT_EQ(r.status, 2) << c.options << "\n" << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.options << "\n" << r.err;
   }
-  // Without cross-validation the default rule falls back to BIC instead of failing.
+  // Without cross-validation the default rule is the elbow alone.
   const SidcRun no_cv = run_sidc("select " + model + " --require m --folds 0");
   EXPECT_EQ(no_cv.status, 0) << no_cv.err;
-  EXPECT_NE(no_cv.out.find("size rule BIC"), std::string::npos) << no_cv.out;
+  EXPECT_NE(no_cv.out.find("size rule elbow"), std::string::npos) << no_cv.out;
+  const SidcRun rule = run_sidc("select " + model + " --rule median");
+  EXPECT_EQ(rule.status, 2) << rule.err;
   const SidcRun method = run_sidc("select " + model + " --method exhaustive");
   EXPECT_EQ(method.status, 2) << method.err;
   const SidcRun missing = run_sidc("select " + shell_quoted(work() / "no_such_model.sid"));

@@ -15,34 +15,62 @@
 namespace sidc {
 namespace {
 
-// Sum of squared residuals of the least-squares polynomial of `degree` in s (degree < 0: none).
-double polynomial_residual(const Eigen::VectorXd& s, const Eigen::VectorXd& v, int degree) {
-  if (degree < 0) return v.squaredNorm();
-  Eigen::MatrixXd V(s.size(), degree + 1);
-  V.col(0).setOnes();
-  for (int k = 1; k <= degree; ++k) V.col(k) = V.col(k - 1).cwiseProduct(s);
-  const Eigen::VectorXd c = V.colPivHouseholderQr().solve(v);
-  return (v - V * c).squaredNorm();
+struct Fit {
+  double residual = 0;  // sum of squares
+  Eigen::Index rank = 0;
+};
+
+// The least-squares fit of v on the columns of V (scaled to unit norm first; rank by pivoted QR).
+Fit fit_on(Eigen::MatrixXd V, const Eigen::VectorXd& v) {
+  if (V.cols() == 0) return {v.squaredNorm(), 0};
+  for (Eigen::Index k = 0; k < V.cols(); ++k)
+    if (const double norm = V.col(k).norm(); norm > 0) V.col(k) /= norm;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(V);
+  qr.setThreshold(1e-10);
+  return {(v - V * qr.solve(v)).squaredNorm(), qr.rank()};
 }
+
+// [1, s, ..., s^degree] beside `absorbed`.
+Eigen::MatrixXd basis(const Eigen::VectorXd& s, int degree, const Eigen::MatrixXd& absorbed) {
+  Eigen::MatrixXd V(s.size(), std::max(degree + 1, 0) + absorbed.cols());
+  for (int k = 0; k <= degree; ++k) V.col(k) = k == 0 ? Eigen::VectorXd::Ones(s.size()) : Eigen::VectorXd(V.col(k - 1).cwiseProduct(s));
+  V.rightCols(absorbed.cols()) = absorbed;
+  return V;
+}
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
 
-double polynomial_share(std::span<const double> time, std::span<const double> values, int degree) {
+double polynomial_share(std::span<const double> time, std::span<const double> values, int degree, const Eigen::MatrixXd& absorbed) {
   const auto n = static_cast<Eigen::Index>(std::min(time.size(), values.size()));
-  if (degree < 0 || n <= degree + 2) return std::numeric_limits<double>::quiet_NaN();
+  if (degree < 0 || n <= degree + 2 + absorbed.cols() || (absorbed.cols() && absorbed.rows() != n)) return kNaN;
   const double first = time.front(), last = time[static_cast<std::size_t>(n - 1)];
   const double middle = 0.5 * (first + last), half = 0.5 * (last - first);
-  if (!(half > 0)) return std::numeric_limits<double>::quiet_NaN();
+  if (!(half > 0)) return kNaN;
   Eigen::VectorXd s(n), v(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     s(i) = (time[static_cast<std::size_t>(i)] - middle) / half;  // on [-1, 1]: the monomials stay well conditioned
     v(i) = values[static_cast<std::size_t>(i)];
   }
-  if (!v.allFinite()) return std::numeric_limits<double>::quiet_NaN();
-  const double lower = polynomial_residual(s, v, degree - 1), upper = polynomial_residual(s, v, degree);
-  // Nothing left beyond degree k - 1 (rounding aside): an integration constant's own shape.
-  if (!(lower > 1e-24 * std::max(v.squaredNorm(), std::numeric_limits<double>::min()))) return std::numeric_limits<double>::quiet_NaN();
-  return std::clamp(1 - upper / lower, 0.0, 1.0);
+  if (!v.allFinite() || !absorbed.allFinite()) return kNaN;
+  const Fit lower = fit_on(basis(s, degree - 1, absorbed), v), upper = fit_on(basis(s, degree, absorbed), v);
+  if (upper.rank == lower.rank) return kNaN;  // t^k is absorbed already (an operation that is a polynomial)
+  // Nothing left beyond what is absorbed (rounding aside): an integration constant's own shape.
+  if (!(lower.residual > 1e-24 * std::max(v.squaredNorm(), std::numeric_limits<double>::min()))) return kNaN;
+  return std::clamp(1 - upper.residual / lower.residual, 0.0, 1.0);
+}
+
+bool is_polynomial(std::span<const double> time, std::span<const double> values, int degree) {
+  const auto n = static_cast<Eigen::Index>(std::min(time.size(), values.size()));
+  if (n <= degree + 1 || !(time[static_cast<std::size_t>(n - 1)] > time.front())) return false;
+  Eigen::VectorXd s(n), v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    s(i) = 2 * (time[static_cast<std::size_t>(i)] - time.front()) / (time[static_cast<std::size_t>(n - 1)] - time.front()) - 1;
+    v(i) = values[static_cast<std::size_t>(i)];
+  }
+  if (!v.allFinite() || v.squaredNorm() == 0) return false;
+  return fit_on(basis(s, degree, Eigen::MatrixXd(n, 0)), v).residual <= kExactPolynomial * v.squaredNorm();
 }
 
 std::vector<DriftFinding> find_drift(const ir::Model& model, const std::vector<std::size_t>& equations, const std::vector<std::string>& columns,
@@ -63,17 +91,31 @@ std::vector<DriftFinding> find_drift(const ir::Model& model, const std::vector<s
       if (rows.empty()) continue;
       std::vector<double> time, values(rows.size());
       for (Eigen::Index i : rows) time.push_back(row_time[static_cast<std::size_t>(i)]);
-      auto consider = [&](int item, const auto& value_of) {
-        for (std::size_t i = 0; i < rows.size(); ++i) values[i] = value_of(rows[i]);
-        const double share = polynomial_share(time, values, k);
-        if (!std::isnan(share) && share > kDriftShare && (!largest.count(item) || share > largest[item].first)) largest[item] = {share, r};
-      };
-      consider(-1, [&](Eigen::Index i) { return b(i); });
+      // Columns that are polynomials in t of degree <= k by construction (a constant term integrated
+      // to tau, a step input) absorb drift of their degree as the integration constants do, and
+      // are no drift themselves: they join the polynomials the shares are measured beyond.
+      std::vector<std::size_t> checked;
+      std::vector<Eigen::VectorXd> absorbing;
       for (std::size_t c = 0; c < columns.size(); ++c) {
         const std::size_t p = column_parameters[c].parameter;
         if (p < model.parameters.size() && model.parameters[p].origin == ir::Parameter::Origin::integration_constant) continue;
-        consider(static_cast<int>(c), [&](Eigen::Index i) { return A(i, static_cast<Eigen::Index>(c)); });
+        Eigen::VectorXd column(static_cast<Eigen::Index>(rows.size()));
+        for (std::size_t i = 0; i < rows.size(); ++i) column(static_cast<Eigen::Index>(i)) = A(rows[i], static_cast<Eigen::Index>(c));
+        if (is_polynomial(time, std::span<const double>(column.data(), rows.size()), k)) absorbing.push_back(column);
+        else checked.push_back(c);
       }
+      Eigen::MatrixXd absorbed(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(absorbing.size()));
+      for (std::size_t a = 0; a < absorbing.size(); ++a) absorbed.col(static_cast<Eigen::Index>(a)) = absorbing[a];
+      auto consider = [&](int item, const auto& value_of) {
+        for (std::size_t i = 0; i < rows.size(); ++i) values[i] = value_of(rows[i]);
+        const double share = polynomial_share(time, values, k, absorbed);
+        if (std::isnan(share) || share <= kDriftShare) return;
+        if (!largest.count(item) || share > largest[item].first) largest[item] = {share, r};
+      };
+      // A known side that is exactly such a polynomial (a step input integrated) is built that way too.
+      for (std::size_t i = 0; i < rows.size(); ++i) values[i] = b(rows[i]);
+      if (!is_polynomial(time, values, k)) consider(-1, [&](Eigen::Index i) { return b(i); });
+      for (std::size_t c : checked) consider(static_cast<int>(c), [&](Eigen::Index i) { return A(i, static_cast<Eigen::Index>(c)); });
     }
     for (const auto& [item, found] : largest) {
       DriftFinding f;

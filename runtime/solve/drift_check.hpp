@@ -4,15 +4,19 @@
 // part of the columns that tells the parameters apart, the estimates rest on what is left, and
 // R^2 stays 1.000000 (uncentred). The case: a pendulum integrated twice over 10,000 s.
 //
-// Relies on: Eigen (a small QR per column). Guarantees: for equation e integrated k >= 1 times, on
-// each record's rows of the design, the known side and each column that is not an integration
-// constant (those are the polynomials of degree < k on purpose) get the share
-//   1 - SS(residual of the best polynomial of degree k) / SS(residual of degree k - 1),
-// the part of what the integration constants can absorb (degree < k, or the mean when k = 1:
-// then the share is the variance explained by a straight line) that the t^k drift explains.
-// Shares above kDriftShare are findings; the warning's wording is
-// diagnostics/model_catalogue.hpp's drift_dominates. Dense fits only (the streamed path keeps no
-// rows); columns that are zero on an equation's rows (another equation's parameters) are skipped.
+// Relies on: Eigen (small pivoted QRs). Guarantees: for equation e integrated k >= 1 times, on each
+// record's rows of the design, the known side and each column that is not an integration
+// constant get the share
+//   1 - SS(residual on P_k) / SS(residual on P_(k-1)),
+// where P_j is the polynomials of degree <= j in t together with the equation's columns that are
+// exactly polynomials of degree <= k (a constant term integrated to `tau`, a step input: built
+// that way, they absorb drift as the integration constants do). That is the part of what the
+// constants (and such columns) can absorb that the t^k drift explains; for k = 1 and no such
+// column, the variance explained by a straight line. Shares above kDriftShare are findings; a
+// column or known side that is itself exactly such a polynomial is none, and nor is any item when
+// t^k is absorbed already. The warning's wording is diagnostics/model_catalogue.hpp's
+// drift_dominates. Dense fits only (the streamed path keeps no rows); columns that are zero on an
+// equation's rows (another equation's parameters) are skipped.
 #pragma once
 
 #include <span>
@@ -28,11 +32,18 @@
 namespace sidc {
 
 inline constexpr double kDriftShare = 0.99;
+inline constexpr double kExactPolynomial = 1e-12;
 
-// 1 - SS_k / SS_(k-1) for the least-squares polynomials of degree k and k - 1 (degree -1: none,
-// so k = 0 compares with 0) in t over the samples; NaN when there are too few samples or the
-// values are a polynomial of degree k - 1 already (nothing left to explain).
-double polynomial_share(std::span<const double> time, std::span<const double> values, int degree);
+// 1 - SS_k / SS_(k-1): the residual sums of squares of `values` on [1, t, ..., t^degree] and on
+// [1, ..., t^(degree-1)], both beside the columns of `absorbed` (rows as values; may have none).
+// NaN when there are too few samples, when t^degree adds nothing to the span, or when nothing is
+// left to explain beyond degree - 1.
+double polynomial_share(std::span<const double> time, std::span<const double> values, int degree,
+                        const Eigen::MatrixXd& absorbed = Eigen::MatrixXd());
+
+// Whether `values` are a polynomial of degree <= `degree` in t to within kExactPolynomial of their
+// sum of squares.
+bool is_polynomial(std::span<const double> time, std::span<const double> values, int degree);
 
 struct DriftFinding {
   std::size_t equation = 0;  // index into the model's equations

@@ -36,6 +36,7 @@ struct FitArguments {
   bool no_validate = false;
   std::vector<std::string> validate;  // further records, not used in fitting
   std::size_t validate_samples = 100000;  // compared at most per record (0 = all)
+  std::string initial_state = "estimate";  // the validation's start: estimated, or read from the record
   std::string plots;                  // --plots DIR
   std::string report;                 // --report FILE.html
 };
@@ -71,6 +72,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   const FitSummary& summary = std::get<FitSummary>(result);
   for (const auto& r : summary.operators)
     for (const auto& w : r.warnings) std::cerr << render(w) << "\n";
+  for (const auto& g : summary.groups)
+    for (const auto& warning : drift_warnings(model, g.drift)) std::cerr << render(warning) << "\n";
   std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << operator_report(summary.operators, options->evaluation);
   if (!is_static(model)) std::cout << "\n";
   std::cout << summary.full_report(model);
@@ -88,7 +91,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (const auto& r : records) checked.push_back(&r);
     for (const auto& r : extra) checked.push_back(&r);
     validation = validate_fit(compiled->normalized, *compiled->explicit_form, summary, checked, records.size(), options->evaluation,
-                              a.validate_samples);
+                              a.validate_samples, a.initial_state == "record" ? InitialState::record : InitialState::estimate);
     if (validation->failed_record)
       return fail(render(cli_diag::cannot_validate(validation->failed_path, *validation->failed_record)), exit_code::user_error);
     std::cout << validation_report(*validation);
@@ -152,6 +155,10 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   add_record_options(cmd, a->records);
   cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv and validation.csv");
   cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all)");
+  cmd->add_option("--initial-state", a->initial_state,
+                  "The validation's initial state: `estimate` (least squares over the record's start, the default) or `record` "
+                  "(the first sample and its moving-arc derivatives)")
+      ->check(CLI::IsMember({"estimate", "record"}));
   cmd->add_option("--plots", a->plots, "Directory for the pictures (SVG and PNG, drawn by gnuplot): outputs, errors, functions, residual tests");
   cmd->add_option("--report", a->report, "Write a one-page HTML report with the fit's tables and pictures to this file");
   auto* no_validate = cmd->add_flag("--no-validate", a->no_validate, "Do not solve the fitted equations and compare them with the records (thesis section 2-4)");

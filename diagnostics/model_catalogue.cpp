@@ -447,4 +447,21 @@ Diagnostic simulate_initial_value_term(const Span& where, std::string_view term)
                "a value at a time other than t0 needs a record; give one with --data, or write the number");
 }
 
+Diagnostic drift_dominates(const Span& where, std::size_t number, int integrations, std::string_view what, std::string_view record, double share,
+                           std::string_view others) {
+  Diagnostic d = error(
+      "drift-dominates", where,
+      fmt::format("equation {} is integrated {} time{} and drift dominates it: on `{}`, {:.4g}% of what the integration constants leave of {} "
+                  "is a polynomial of degree {} in t{}; the estimates rest on the remaining {:.2g}%",
+                  number, integrations, integrations == 1 ? "" : "s", record, 100 * share, what, integrations, others.empty() ? "" : fmt::format(" ({})", others),
+                  100 * (1 - share)),
+      integrations > 1 ? fmt::format("fit a shorter window (--from/--to, `set from`/`set to`), use the weak form (`set form = weak`), or integrate fewer "
+                                     "times (`set integrate = {}`)",
+                                     integrations - 1)
+                       : std::string("fit a shorter window (--from/--to, `set from`/`set to`), use the weak form (`set form = weak`), or the derivative "
+                                     "form (`set integrate = 0`)"));
+  d.severity = Severity::warning;
+  return d;
+}
+
 }  // namespace sidc::diag

@@ -145,4 +145,11 @@ Diagnostic simulate_equation_count(const Span& where, std::size_t equations, std
 Diagnostic highest_derivatives_unmatched(const Span& where, std::string_view derivatives);
 Diagnostic simulate_initial_value_term(const Span& where, std::string_view term);
 
+// ---- the fit's data (runtime/solve/drift_check.cpp) ------------------------------------------
+// A warning: equation `number` (1-based), integrated `integrations` times, has `what` (e.g. "its
+// known side `int(int(x))`") mostly a polynomial of degree `integrations` in t on `record`;
+// `others` names further operations so dominated ("as is the operation of `k`"; may be empty).
+Diagnostic drift_dominates(const Span& where, std::size_t number, int integrations, std::string_view what, std::string_view record, double share,
+                           std::string_view others);
+
 }  // namespace sidc::diag

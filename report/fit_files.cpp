@@ -75,13 +75,18 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
     for (const auto& r : g.regions) regions.push_back({{"guards", r.guards}, {"rows", r.rows}});
     ordered_json dependent = ordered_json::array();
     for (const auto& d : ls.dependent_groups) dependent.push_back(d);
+    ordered_json drift = ordered_json::array();
+    for (const auto& d : g.drift)
+      drift.push_back({{"equation", d.equation + 1}, {"what", d.what}, {"operation", d.operation}, {"record", d.record},
+                       {"degree", d.degree}, {"share", d.share}});
     groups.push_back({{"equations", equations}, {"records", records}, {"regions", regions}, {"parameters", parameters},
                       {"statistics", {{"n", ls.n}, {"p", ls.p}, {"rank", ls.rank}, {"G", ls.G}, {"standard_error", ls.standard_error},
-                                      {"residual_sd", ls.residual_sd}, {"r_squared", ls.r_squared}, {"aic", ls.aic}, {"bic", ls.bic},
+                                      {"residual_sd", ls.residual_sd}, {"r_squared", ls.r_squared},
+                                      {"r_squared_uncentred", ls.uncentred_r_squared}, {"r_squared_centred", ls.centred_r_squared}, {"aic", ls.aic}, {"bic", ls.bic},
                                       {"condition_before_scaling", ls.condition_before}, {"condition_after_scaling", ls.condition_after},
                                       {"digits_lost_estimate", ls.digits_lost_estimate}}},
                       {"termination", to_string(ls.termination)}, {"message", ls.message}, {"arithmetic", ls.arithmetic},
-                      {"dependent_operations", dependent}});
+                      {"dependent_operations", dependent}, {"drift", drift}});
   }
   j["groups"] = std::move(groups);
   ordered_json noise = ordered_json::array();
@@ -135,15 +140,29 @@ nlohmann::ordered_json validation_json(const FitValidation& v) {
   j["note"] = v.note.empty() ? ordered_json(nullptr) : ordered_json(v.note);
   ordered_json runs = ordered_json::array();
   for (const auto& run : v.runs) {
-    ordered_json outputs = ordered_json::array();
-    for (const auto& r : run.outputs)
+    ordered_json outputs = ordered_json::array(), verdict = ordered_json::array();
+    auto optional = [](const std::optional<double>& x) { return x ? ordered_json(*x) : ordered_json(nullptr); };
+    for (const auto& r : run.outputs) {
       outputs.push_back({{"output", r.output}, {"samples", r.samples}, {"max_abs_error", r.max_abs_error}, {"time_of_max_abs_error", r.time_of_max},
                          {"percent_error", r.percent_error}, {"fit_percent", r.fit_percent}, {"rms_error", r.rms_error}});
-    ordered_json initial = ordered_json::object();
-    for (const auto& [name, value] : run.initial_state) initial[name] = value;
+      verdict.push_back({{"output", r.output}, {"fit_percent", r.fit_percent}, {"follows", r.follows}, {"departs_at", optional(r.departs_at)},
+                         {"max_error", r.max_abs_error}, {"time_of_max_error", r.time_of_max}});
+    }
+    auto state = [](const std::vector<std::pair<std::string, double>>& named) {
+      ordered_json o = ordered_json::object();
+      for (const auto& [name, value] : named) o[name] = value;
+      return o;
+    };
+    const bool estimated = run.initial_method == InitialState::estimate && run.start_segment > 0;
     runs.push_back({{"record", run.record}, {"completed", run.simulation.completed()},
-                    {"stopped_at", run.simulation.stopped_at ? ordered_json(*run.simulation.stopped_at) : ordered_json(nullptr)},
-                    {"statement", run.statement}, {"initial_state", initial}, {"steps", run.simulation.steps}, {"outputs", outputs}});
+                    {"stopped_at", optional(run.simulation.stopped_at)},
+                    {"statement", run.statement},
+                    {"verdict", {{"follows", run.follows}, {"threshold_fit_percent", kFollowsFitPercent}, {"departure_share", kDepartureShare},
+                                 {"outputs", verdict}}},
+                    {"initial_state", state(run.initial_state)}, {"initial_state_method", estimated ? "estimate" : "record"},
+                    {"initial_state_from_record", state(run.recorded_state)},
+                    {"start_segment_samples", estimated ? ordered_json(run.start_segment) : ordered_json(nullptr)},
+                    {"steps", run.simulation.steps}, {"outputs", outputs}});
   }
   j["records"] = std::move(runs);
   return j;

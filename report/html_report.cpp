@@ -114,6 +114,7 @@ void fill_group_from(const LeastSquaresSummary& summary, double confidence_level
   s.residual_sd = summary.residual_sd;
   s.r_squared = summary.r_squared;
   s.r_squared_centred = summary.r_squared_centred;
+  s.other_r_squared = summary.r_squared_centred ? summary.uncentred_r_squared : summary.centred_r_squared;
   s.condition = summary.condition_after;
   s.termination = to_string(summary.termination);
 }
@@ -168,10 +169,11 @@ std::string render_html_report(const ReportContent& content) {
     const auto& s = group.statistics;
     out += "<h3>Statistics</h3>\n<table>\n<tr><th>n</th><th>G(a)</th><th>standard error</th><th>residual SD</th>"
            "<th>R&sup2;</th><th>condition</th><th>rank</th><th class=\"name\">termination</th></tr>\n";
-    out += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{} of {}</td>"
+    out += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}{}; {} {}</td><td>{}</td><td>{} of {}</td>"
                        "<td class=\"name\">{}</td></tr>\n</table>\n",
                        s.n, number(s.G, 6), number(s.standard_error, 4), number(s.residual_sd, 4),
-                       number(s.r_squared, 6), s.r_squared_centred ? "" : " (uncentred)", number(s.condition, 3),
+                       number(s.r_squared, 6), s.r_squared_centred ? " (centred)" : " (uncentred)",
+                       s.r_squared_centred ? "uncentred" : "centred", number(s.other_r_squared, 6), number(s.condition, 3),
                        s.rank, s.p, html_escape(s.termination));
     out += "<p class=\"meta\">G(a) = sum of squared residuals (eq. 2-1.7); standard error sqrt(G/n) (thesis); "
            "residual SD sqrt(G/(n &minus; rank)); condition number of the scaled design.</p>\n";

@@ -36,6 +36,7 @@ struct ReportStatistics {
   double residual_sd = 0;     // sqrt(G/(n - rank))
   double r_squared = 0;
   bool r_squared_centred = false;
+  double other_r_squared = 0;  // the centred one beside an uncentred r_squared, and the other way round
   double condition = 0;       // after scaling
   std::string termination;    // "success", "rank deficient", ...
 };

@@ -83,7 +83,7 @@ struct SelectOptions {
   int max_size = -1;                  // largest subset size reported (-1 = all)
   SizeRule rule = SizeRule::elbow;    // which criterion names the non-contributory operations
   double elbow_share = kElbowShare;   // the elbow's step leaves at most this share of log(G/G_full) (size_rule.hpp)
-  double drift_share = kDriftShare;   // a candidate this close to a polynomial in t is a drift absorber
+  double drift_share = kDriftAbsorberShare;   // a candidate this close to a polynomial in t is a drift absorber
   bool keep_drift = false;            // search drift absorbers of integrated equations too
   double tolerance = 1e-10;           // of the exact search, relative to G(0) (best_subset.hpp)
 

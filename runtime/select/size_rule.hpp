@@ -42,7 +42,7 @@ inline constexpr double kElbowShare = 0.1;
 // variance explained) is flagged as a drift absorber (docs/selection.md: true operations of the
 // measured records stay below 0.99, the absorbers above 0.9999). Of the operation before
 // integration, see operation_line_share.
-inline constexpr double kDriftShare = 0.999;
+inline constexpr double kDriftAbsorberShare = 0.999;
 
 struct ElbowResult {
   std::vector<double> left;  // per size (as given): share of log(G_{k-1}/G_p) left after the step; NaN for the first

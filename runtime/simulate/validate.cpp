@@ -1,12 +1,48 @@
 #include "runtime/simulate/validate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <fmt/format.h>
 
+#include "runtime/simulate/initial_state.hpp"
 #include "runtime/solve/fitted_values.hpp"
 
 namespace sidc {
+namespace {
+
+std::vector<std::pair<std::string, double>> named_state(const ExplicitForm& form, const std::map<std::string, std::vector<double>>& initial) {
+  std::vector<std::pair<std::string, double>> named;
+  for (const auto& out : form.outputs)
+    for (int m = 0; m < out.order; ++m) {
+      auto it = initial.find(out.name);
+      const auto k = static_cast<std::size_t>(m);
+      named.emplace_back(out.name + std::string(k, '\''), it != initial.end() && k < it->second.size() ? it->second[k] : 0.0);
+    }
+  return named;
+}
+
+// The first time the local RMS of `e` (kDepartureHalfWidth samples either side, those that are
+// finite) exceeds `limit`; none when it never does.
+std::optional<double> departure(const std::vector<double>& e, const std::vector<double>& time, double limit) {
+  const std::size_t n = e.size(), w = kDepartureHalfWidth;
+  for (std::size_t i = 0; i < n; ++i) {
+    double squares = 0;
+    std::size_t count = 0;
+    for (std::size_t k = i > w ? i - w : 0; k <= std::min(n - 1, i + w); ++k)
+      if (std::isfinite(e[k])) squares += e[k] * e[k], ++count;
+    if (count && std::sqrt(squares / static_cast<double>(count)) > limit) return time[i];
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+const char* to_string(InitialState initial) { return initial == InitialState::record ? "record" : "estimate"; }
+
+std::size_t start_segment_samples(std::size_t compared) {
+  return std::min(compared, std::clamp<std::size_t>(compared / 10, 20, 1000));
+}
 
 std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
                                                      const SampledRecord& record, const ValidationOptions& options) {
@@ -53,16 +89,26 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   ValidationSummary v;
   v.record = record.path;
   v.truncated = static_cast<std::size_t>(to) < record.time.size();
-  for (const auto& out : form.outputs)
-    for (int m = 0; m < out.order; ++m)
-      v.initial_state.emplace_back(out.name + std::string(static_cast<std::size_t>(m), '\''), o.initial[out.name][static_cast<std::size_t>(m)]);
+  v.recorded_state = named_state(form, o.initial);
+  std::vector<std::vector<double>> recorded;  // per output, on o.time
+  for (const auto& out : form.outputs) {
+    const auto& column = record.signals.at(out.name);
+    recorded.emplace_back(column.begin() + from, column.begin() + to);
+  }
+  v.initial_method = options.initial_state;
+  if (options.initial_state == InitialState::estimate && o.time.size() >= 2) {
+    const InitialStateEstimate estimate = estimate_initial_state(normalized, form, o, recorded, start_segment_samples(o.time.size()));
+    o.initial = estimate.initial;
+    v.start_segment = estimate.segment;
+    v.estimate_iterations = estimate.iterations;
+  }
+  v.initial_state = named_state(form, o.initial);
   auto run = simulate(normalized, form, o);
   if (auto* d = std::get_if<Diagnostic>(&run)) return *d;
   v.simulation = std::get<SimulationSummary>(std::move(run));
 
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {
-    const auto& recorded = record.signals.at(form.outputs[j].name);
-    const std::vector<double> y(recorded.begin() + from, recorded.begin() + to);
+    const std::vector<double>& y = recorded[j];
     const std::vector<double>& yhat = v.simulation.outputs[j];
     OutputValidation r;
     r.output = form.outputs[j].name;
@@ -85,22 +131,32 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     r.percent_error = max_observed > 0 ? 100 * r.max_abs_error / max_observed : NAN;  // eq. 4-1.5
     r.fit_percent = sum_d2 > 0 ? 100 * (1 - std::sqrt(sum_e2 / sum_d2)) : NAN;
     r.rms_error = r.samples ? std::sqrt(sum_e2 / static_cast<double>(r.samples)) : NAN;
+    r.follows = v.simulation.completed() && r.fit_percent >= kFollowsFitPercent;
+    const double spread = r.samples ? std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;
+    r.departs_at = departure(e, o.time, kDepartureShare * spread);
+    if (!r.departs_at && !v.simulation.completed()) r.departs_at = v.simulation.stopped_at;
     v.outputs.push_back(r);
     v.recorded.push_back(y);
     v.simulated.push_back(yhat);
     v.error.push_back(std::move(e));
   }
+  v.follows = v.simulation.completed() && std::all_of(v.outputs.begin(), v.outputs.end(), [](const OutputValidation& r) { return r.follows; });
   if (v.simulation.completed()) {
     // The sentence follows from the numbers: "follow it" only when every output's fit % reaches
-    // kFollowsFitPercent; otherwise it names each output that falls short, where it departs most
-    // and by how much.
+    // kFollowsFitPercent; otherwise it names each output that falls short, where it departs and
+    // its largest error.
     std::string parts, short_of;
     for (const auto& r : v.outputs) {
       const std::string numbers = fmt::format("max |E[{}]| = {:.4g} at t = {:.4g} ({:.3g}% of max |{}|, eq. 4-1.5)", r.output, r.max_abs_error,
                                               r.time_of_max, r.percent_error, r.output);
       parts += (parts.empty() ? "" : "; ") + numbers;
-      if (!(r.fit_percent >= kFollowsFitPercent))
-        short_of += fmt::format("{}fit {:.3g}% for {} (below {:g}%), {}", short_of.empty() ? "" : "; ", r.fit_percent, r.output, kFollowsFitPercent, numbers);
+      if (r.follows) continue;
+      const std::string departs =
+          r.departs_at ? fmt::format("departs at t = {:.4g} (local RMS error above {:g}% of the standard deviation of {}), ", *r.departs_at,
+                                     100 * kDepartureShare, r.output)
+                       : std::string();
+      short_of += fmt::format("{}fit {:.3g}% for {} (below {:g}%), {}{}", short_of.empty() ? "" : "; ", r.fit_percent, r.output, kFollowsFitPercent,
+                              departs, numbers);
     }
     v.statement = short_of.empty() ? "The fitted equations, solved from the record, follow it: " + parts + "."
                                    : "The fitted equations, solved from the record, do not follow it: " + short_of + ".";
@@ -113,11 +169,20 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
 }
 
 std::string ValidationSummary::report(const std::string& method) const {
-  std::string initial;
-  for (const auto& [name, value] : initial_state) initial += fmt::format("{}{} = {:.6g}", initial.empty() ? "" : ", ", name, value);
+  auto listed = [](const std::vector<std::pair<std::string, double>>& state) {
+    std::string text;
+    for (const auto& [name, value] : state) text += fmt::format("{}{} = {:.6g}", text.empty() ? "" : ", ", name, value);
+    return text;
+  };
   std::string out = fmt::format("validation (thesis section 2-4): the fitted equations solved by {} against `{}`,\n", method, record);
-  out += fmt::format("  from t = {:.6g} with {} (taken from the record; derivatives by the moving arc)\n",
-                     simulation.time.empty() ? 0.0 : simulation.time.front(), initial);
+  const double first = simulation.time.empty() ? 0.0 : simulation.time.front();
+  if (initial_method == InitialState::estimate && start_segment > 0)
+    out += fmt::format("  from t = {:.6g} with {} (estimated by least squares over the first {} samples, to t = {:.6g}, {} step{};\n"
+                       "  the record gives {}: sample and moving-arc derivatives)\n",
+                       first, listed(initial_state), start_segment, simulation.time.size() >= start_segment ? simulation.time[start_segment - 1] : first,
+                       estimate_iterations, estimate_iterations == 1 ? "" : "s", listed(recorded_state));
+  else
+    out += fmt::format("  from t = {:.6g} with {} (taken from the record; derivatives by the moving arc)\n", first, listed(initial_state));
   out += fmt::format("  {:<10} {:>8} {:>12} {:>10} {:>16} {:>10} {:>12}\n", "output", "samples", "max |E|", "at t", "%E (eq. 4-1.5)", "fit %", "RMS E");
   for (const auto& r : outputs)
     out += fmt::format("  {:<10} {:>8} {:>12.4g} {:>10.4g} {:>16.3g} {:>10.4g} {:>12.4g}\n", r.output, r.samples, r.max_abs_error, r.time_of_max,
@@ -128,7 +193,7 @@ std::string ValidationSummary::report(const std::string& method) const {
 
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
-                           std::size_t max_samples) {
+                           std::size_t max_samples, InitialState initial_state) {
   FitValidation v;
   v.max_samples = max_samples;
   if (!summary.is_solution_usable()) {
@@ -143,6 +208,7 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   ValidationOptions o;
   o.evaluation = evaluation;
   o.max_samples = max_samples;
+  o.initial_state = initial_state;
   for (std::size_t r = 0; r < records.size(); ++r) {
     auto run = validate(normalized, std::get<ExplicitForm>(form), parameters, *records[r], o);
     if (auto* d = std::get_if<Diagnostic>(&run)) {

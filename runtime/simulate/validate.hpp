@@ -3,16 +3,20 @@
 // ... established by the least squares solution", compared with the record (section 4-1: max
 // E[y] = 0.03, %E[y] = 1.5% for the odd-order model at Delta = 0.020).
 //
-// Relies on: runtime/simulate/simulate.hpp, the explicit form of the *normalized* (derivative-form) model,
-// so an integrated fit is validated through the equation it integrated; integration constants
-// are not needed. Guarantees: the model is solved from the first sample where every state
-// derivative has its centred moving-arc estimate (t = 3 Delta for y' by the 7-point operator; y
-// itself by value) to the end of the record (or ValidationOptions::max_samples later), inputs taken from the record; per output it gives the error curve E[y] = y_recorded -
-// y_simulated (eq. 4-1.4), max |E| and its time, the thesis' percentage error 100 max|E| /
-// max|y_recorded| (eq. 4-1.5: the error over the largest observed magnitude), MATLAB's fit
-// percentage 100 (1 - ||y - yhat|| / ||y - mean(y)||), and the RMS error. A run that diverges or
-// becomes singular is not an error: the statement says so and when, and the numbers cover the
-// samples before the stop.
+// Relies on: runtime/simulate/simulate.hpp, runtime/simulate/initial_state.hpp, the explicit form of
+// the *normalized* (derivative-form) model, so an integrated fit is validated through the equation
+// it integrated; integration constants are not needed. Guarantees: the model is solved from the
+// first sample where every state derivative has its centred moving-arc estimate (t = 3 Delta for
+// y' by the 7-point operator; y itself by value) to the end of the record (or
+// ValidationOptions::max_samples later), inputs taken from the record. The initial state is, by
+// default, estimated by least squares over a start segment (start_segment_samples), starting from
+// the recorded sample and its moving-arc derivatives; InitialState::record uses those as they are.
+// Per output it gives the error curve E[y] = y_recorded - y_simulated (eq. 4-1.4), max |E| and its
+// time, the thesis' percentage error 100 max|E| / max|y_recorded| (eq. 4-1.5: the error over the
+// largest observed magnitude), MATLAB's fit percentage 100 (1 - ||y - yhat|| / ||y - mean(y)||),
+// the RMS error, whether it follows (fit % >= kFollowsFitPercent) and where it departs. A run that
+// diverges or becomes singular is not an error: the statement says so and when, and the numbers
+// cover the samples before the stop.
 #pragma once
 
 #include <optional>
@@ -30,10 +34,31 @@ namespace sidc {
 // The verdict's threshold: the fitted equations "follow" the record when, for every output, the
 // simulated output's error is at most a tenth of the output's own variation about its mean (fit %
 // = 100 (1 - ||y - yhat|| / ||y - mean(y)||) >= 90, MATLAB compare's measure). Below it the sentence
-// says "do not follow it" and names the output, the fit % and where it departs most. A noisy
-// record lowers fit % by its noise: at a noise of 1% of the output's spread the cost is about 1
-// point, so the threshold separates a wrong model from a noisy record.
+// says "do not follow it" and names the output, the fit %, where it departs (kDepartureShare) and
+// its largest error. A noisy record lowers fit % by its noise: at a noise of 1% of the output's
+// spread the cost is about 1 point, so the threshold separates a wrong model from a noisy record
+// (once the start no longer comes from one noisy sample: InitialState::estimate).
 inline constexpr double kFollowsFitPercent = 90;
+
+// Where a run departs from the record: the first sample where the local RMS error (over the
+// kDepartureHalfWidth samples either side, so one noisy sample does not count) exceeds
+// kDepartureShare of the output's standard deviation about its mean: the share fit % allows over
+// the whole record (fit % = 90 is an RMS error of 0.1 standard deviations), applied locally.
+inline constexpr double kDepartureShare = 0.1;
+inline constexpr std::size_t kDepartureHalfWidth = 5;
+
+// Where the simulation's initial state comes from.
+enum class InitialState {
+  record,    // the sample at the start and its moving-arc derivatives (noisy on a noisy record)
+  estimate,  // least squares over the start segment, from the recorded guess (MATLAB compare's estimate)
+};
+const char* to_string(InitialState initial);
+
+// The start segment over which the initial state is estimated: a tenth of the samples compared,
+// at least 20 (so that the noise averages out over more samples than there are states) and at
+// most 1000 (each Levenberg-Marquardt iteration runs it once per state component). A fixed share
+// rather than the system's time scales, which are what is being validated.
+std::size_t start_segment_samples(std::size_t compared);
 
 struct ValidationOptions {
   SimulateOptions::Method method = SimulateOptions::Method::rk4;
@@ -43,6 +68,7 @@ struct ValidationOptions {
   // Samples compared at most, from the start (0 = all). A free run costs about 2 us per equation
   // evaluation, 16 per sample: 10^7 samples would take minutes, so sidc fit bounds it.
   std::size_t max_samples = 0;
+  InitialState initial_state = InitialState::estimate;
 };
 
 struct OutputValidation {
@@ -53,12 +79,19 @@ struct OutputValidation {
   double percent_error = 0;       // eq. 4-1.5
   double fit_percent = 0;         // 100 (1 - ||y - yhat|| / ||y - mean(y)||)
   double rms_error = 0;
+  bool follows = false;               // fit % >= kFollowsFitPercent and the run completed
+  std::optional<double> departs_at;   // see kDepartureShare; the stop when it stopped first; none when it never departs
 };
 
 struct ValidationSummary {
   std::string record;
   SimulationSummary simulation;
-  std::vector<std::pair<std::string, double>> initial_state;  // ("y'", value)
+  std::vector<std::pair<std::string, double>> initial_state;  // ("y'", value): the state the run started from
+  std::vector<std::pair<std::string, double>> recorded_state;  // the same read from the record (moving arc)
+  InitialState initial_method = InitialState::record;
+  std::size_t start_segment = 0;     // samples the estimate fitted (estimate only)
+  int estimate_iterations = 0;       // Levenberg-Marquardt steps taken
+  bool follows = false;              // every output follows
   std::vector<OutputValidation> outputs;
   std::vector<std::vector<double>> recorded, simulated, error;  // per output, on simulation.time
   std::string statement;  // one plain sentence: how well, or where it diverged
@@ -86,12 +119,12 @@ struct FitValidation {
 // compared with. `form`: the compiled model's explicit form of `normalized`.
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
-                           std::size_t max_samples);
+                           std::size_t max_samples, InitialState initial_state = InitialState::estimate);
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
-// with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record, scored by the
-// RMS error over outputs and records; infinity when a run diverges, nullopt when a record cannot
-// be compared.
+// with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record (its initial
+// state estimated as validate() does by default), scored by the RMS error over outputs and records; infinity when a run
+// diverges, nullopt when a record cannot be compared.
 std::optional<double> simulation_rms_error(const ir::Model& normalized, const ExplicitForm& form, const std::vector<ParameterIndex>& subset,
                                            const std::vector<double>& values, const std::vector<SampledRecord>& records,
                                            const EvaluationOptions& evaluation, std::size_t max_samples);

@@ -436,6 +436,9 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
     g.regions = std::get<std::vector<Region>>(std::move(regions));
     if (auto problem = design.too_few_rows(total_rows, evaluation.front())) return *problem;
+    std::vector<std::string> paths;
+    for (const auto& r : records) paths.push_back(r.path);
+    g.drift = find_drift(model, members, g.columns, g.column_parameters, A, b, g.row_equation, g.row_record, g.row_time, paths);
     g.summary = solve_least_squares(A, b, g.columns, g.weighted ? &weights : nullptr, options.least_squares);
     design.label(g.summary);
     summary.groups.push_back(std::move(g));
@@ -547,7 +550,10 @@ std::string FitSummary::full_report(const ir::Model& model) const {
       out += "  residuals weighted by the record's weight column (eq. 2-1.6)\n";
     out += fmt::format("  G(a) = {:.6g} (eq. 2-1.7)   standard error sqrt(G/n) = {:.4g}   residual s.d. = {:.4g}\n", s.G,
                        s.standard_error, s.residual_sd);
-    out += fmt::format("  n = {}, p = {}, rank {}   R^2 = {:.6f}   AIC = {:.4g}   BIC = {:.4g}\n", s.n, s.p, s.rank, s.r_squared, s.aic, s.bic);
+    // Both R^2: an uncentred 1.000000 beside a centred 0.3 says the known side is mostly its mean or a drift.
+    out += fmt::format("  n = {}, p = {}, rank {}   R^2 = {:.6f} ({}; {} {:.6f})   AIC = {:.4g}   BIC = {:.4g}\n", s.n, s.p, s.rank, s.r_squared,
+                       s.r_squared_centred ? "centred" : "uncentred", s.r_squared_centred ? "uncentred" : "centred",
+                       s.r_squared_centred ? s.uncentred_r_squared : s.centred_r_squared, s.aic, s.bic);
     out += fmt::format("  condition {:.3g} before scaling, {:.3g} after (section 3-2); about {:.1f} digits lost\n", s.condition_before,
                        s.condition_after, s.digits_lost_estimate);
     out += fmt::format("  arithmetic: {}\n", s.arithmetic);

@@ -28,6 +28,7 @@
 #include "runtime/operators/evaluate.hpp"
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/solve/design.hpp"
+#include "runtime/solve/drift_check.hpp"
 #include "runtime/solve/least_squares.hpp"
 
 namespace sidc {
@@ -77,6 +78,7 @@ struct GroupFit {
   std::vector<std::size_t> row_equation, row_record;
   std::vector<double> row_time;
   std::vector<double> known;  // the right-hand side per row
+  std::vector<DriftFinding> drift;  // integrated equations dominated by drift (drift_check.hpp; dense fits only)
   // Empty for a dense fit; for a streamed one, how (printed in the report), e.g. "streamed QR over
   // 9999988 rows in blocks of 2048 rows on 2 threads", and the per-row vectors above are empty.
   std::string streamed;

@@ -469,6 +469,7 @@ LeastSquaresSummary failed(LeastSquaresSummary::Termination termination, std::st
   summary.p = p;
   for (const std::string& name : names) summary.parameters.push_back({name, kNaN, kNaN, kNaN, kNaN});
   summary.G = summary.standard_error = summary.residual_sd = summary.r_squared = kNaN;
+  summary.centred_r_squared = summary.uncentred_r_squared = kNaN;
   summary.aic = summary.bic = kNaN;
   summary.condition_before = summary.condition_after = summary.digits_lost_estimate = kNaN;
   return summary;
@@ -562,20 +563,31 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
   }
   const bool centred_r2 = options.intercept_in_r2 && constant_column >= 0;
   summary.r_squared_centred = centred_r2;
+  double total_centred = 0, total_uncentred = 0;  // sum w^2 (b - ybar_w)^2 and sum (w b)^2
   if (streamed) {
     G += Ext(streamed->residual_sum_of_squares);
-    const double total = centred_r2 ? streamed->total_centred : streamed->total_uncentred;
+    total_centred = streamed->total_centred;
+    total_uncentred = streamed->total_uncentred;
+    const double total = centred_r2 ? total_centred : total_uncentred;
     summary.r_squared = total > 0 ? 1.0 - to_double(G) / total : kNaN;
   } else {
     const Ext mean = weight_sum > 0 ? weighted_b_sum / weight_sum : Ext(0);
-    Ext explained = 0;
+    Ext explained = 0, centred = 0, uncentred = 0;
     for (Index i = 0; i < rows_n; ++i) {
       const Ext w = Ext(rows.weight(i));
       const Ext deviation = w * (fitted[static_cast<std::size_t>(i)] - (centred_r2 ? mean : Ext(0)));
       explained += deviation * deviation;
+      centred += (w * (Ext(rows.b(i)) - mean)) * (w * (Ext(rows.b(i)) - mean));
+      uncentred += (w * Ext(rows.b(i))) * (w * Ext(rows.b(i)));
     }
     summary.r_squared = explained + G > 0 ? to_double(explained / (explained + G)) : kNaN;
+    total_centred = to_double(centred);
+    total_uncentred = to_double(uncentred);
   }
+  // The one not chosen as r_squared, as 1 - G / TSS (the chosen one keeps its SSR / (SSR + G) digits).
+  const auto one_minus = [&](double total) { return total > 0 ? 1.0 - to_double(G) / total : kNaN; };
+  summary.centred_r_squared = centred_r2 ? summary.r_squared : one_minus(total_centred);
+  summary.uncentred_r_squared = centred_r2 ? one_minus(total_uncentred) : summary.r_squared;
   summary.G = to_double(G);
   const double n_double = static_cast<double>(n);
   const double k = static_cast<double>(attempt.rank);
@@ -706,6 +718,8 @@ std::string LeastSquaresSummary::full_report() const {
   line("standard error sqrt(G/n)", format_number(standard_error));
   line("residual SD sqrt(G/(n-rank))", format_number(residual_sd));
   line(r_squared_centred ? "R^2 (centred)" : "R^2 (uncentred)", format_number(r_squared));
+  line(r_squared_centred ? "R^2 uncentred (beside it)" : "R^2 centred (beside it)",
+       format_number(r_squared_centred ? uncentred_r_squared : centred_r_squared));
   line("AIC, BIC (n log(G/n) + ...)", format_number(aic) + ", " + format_number(bic));
   text += fmt::format("  {:<16} {:>18} {:>14} {:>18} {:>18}\n", "parameter", "estimate", "std. error",
                       "CI low", "CI high");

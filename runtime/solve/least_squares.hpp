@@ -28,6 +28,11 @@
 //   constant column and intercept_in_r2 is set; otherwise uncentred, SSR = sum (w_i yhat_i)^2
 //   (NIST's convention for its no-intercept sets). Writing it as SSR / (SSR + G) rather than
 //   1 - G / TSS keeps its digits when R^2 is small (Wampler5: R^2 = 0.0022).
+//   Both are also given apart (centred_r_squared, uncentred_r_squared): the uncentred one measures
+//   the fit against predicting 0, the centred one against predicting the mean of b, so a known
+//   side dominated by its mean or a slow drift shows R^2 = 1.000000 uncentred and a centred one
+//   far below; the centred one is 1 - G / sum w_i^2 (b_i - ybar_w)^2, negative when the fit does
+//   worse than the mean.
 // - AIC = n log(G/n) + 2k and BIC = n log(G/n) + k log(n), Gaussian errors with the variance
 //   profiled out and additive constants dropped; k = rank (the parameters actually estimated).
 //   Only differences between models fitted to the same rows mean anything.
@@ -127,7 +132,8 @@ struct LeastSquaresSummary {
   double standard_error = 0;  // thesis (Table 4-1.2): sqrt(G/n)
   double residual_sd = 0;     // sqrt(G/(n - rank)); NaN when n == rank
   double r_squared = 0;
-  bool r_squared_centred = false;
+  bool r_squared_centred = false;  // which of the two below r_squared is
+  double centred_r_squared = 0, uncentred_r_squared = 0;
   double aic = 0, bic = 0;
 
   // 2-norm condition numbers (sigma_max / sigma_min, from the singular values of the p x p

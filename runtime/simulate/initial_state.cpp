@@ -1,0 +1,153 @@
+// Levenberg-Marquardt over the initial state (see initial_state.hpp).
+#include "runtime/simulate/initial_state.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace sidc {
+namespace {
+
+constexpr int kMaxIterations = 30;
+constexpr int kMaxDampingTries = 12;  // lambda grows tenfold per rejected trial step
+
+// The segment's least-squares problem: the state as a vector, its residuals by a free run.
+class StartProblem {
+ public:
+  StartProblem(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& whole, const std::vector<std::vector<double>>& recorded,
+               std::size_t segment)
+      : model_(model), form_(form), options_(whole), recorded_(recorded), segment_(segment) {
+    options_.time.resize(segment);
+    for (auto& [name, values] : options_.inputs) values.resize(segment);
+    const double duration = options_.time.back() - options_.time.front();
+    for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+      double mean = 0, squares = 0;
+      for (std::size_t i = 0; i < segment; ++i) mean += recorded[j][i];
+      mean /= static_cast<double>(segment);
+      for (std::size_t i = 0; i < segment; ++i) squares += (recorded[j][i] - mean) * (recorded[j][i] - mean);
+      const double sd = std::sqrt(squares / static_cast<double>(segment));
+      scale_.push_back(sd > 0 && std::isfinite(sd) ? sd : 1.0);
+      // A typical size of y^(m) for the finite-difference steps: the spread over the segment's duration^m.
+      for (int m = 0; m < form.outputs[j].order; ++m) {
+        layout_.emplace_back(form.outputs[j].name, m);
+        typical_.push_back(scale_.back() / std::pow(duration > 0 ? duration : 1.0, m));
+      }
+    }
+  }
+
+  std::size_t size() const { return layout_.size(); }
+  std::size_t rows() const { return segment_ * form_.outputs.size(); }
+  double typical(std::size_t k) const { return typical_[k]; }
+
+  Eigen::VectorXd vector_of(const std::map<std::string, std::vector<double>>& initial) const {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(size()));
+    for (std::size_t k = 0; k < layout_.size(); ++k) {
+      auto it = initial.find(layout_[k].first);
+      const auto m = static_cast<std::size_t>(layout_[k].second);
+      if (it != initial.end() && m < it->second.size()) x(static_cast<Eigen::Index>(k)) = it->second[m];
+    }
+    return x;
+  }
+
+  std::map<std::string, std::vector<double>> map_of(const Eigen::VectorXd& x) const {
+    std::map<std::string, std::vector<double>> initial;
+    for (std::size_t k = 0; k < layout_.size(); ++k) initial[layout_[k].first].push_back(x(static_cast<Eigen::Index>(k)));
+    return initial;
+  }
+
+  // (recorded - simulated) / s_j over the segment; false when the run fails or is not finite.
+  bool residuals(const Eigen::VectorXd& x, Eigen::VectorXd& r) {
+    options_.initial = map_of(x);
+    auto run = simulate(model_, form_, options_);
+    if (!std::holds_alternative<SimulationSummary>(run)) return false;
+    const auto& s = std::get<SimulationSummary>(run);
+    if (!s.completed()) return false;
+    r.resize(static_cast<Eigen::Index>(rows()));
+    for (std::size_t j = 0; j < form_.outputs.size(); ++j)
+      for (std::size_t i = 0; i < segment_; ++i) {
+        const double v = (recorded_[j][i] - s.outputs[j][i]) / scale_[j];
+        if (!std::isfinite(v)) return false;
+        r(static_cast<Eigen::Index>(j * segment_ + i)) = v;
+      }
+    return true;
+  }
+
+ private:
+  const ir::Model& model_;
+  const ExplicitForm& form_;
+  SimulateOptions options_;
+  const std::vector<std::vector<double>>& recorded_;
+  std::size_t segment_;
+  std::vector<double> scale_, typical_;
+  std::vector<std::pair<std::string, int>> layout_;  // (output, derivative order) per state component
+};
+
+}  // namespace
+
+InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options,
+                                            const std::vector<std::vector<double>>& recorded, std::size_t segment) {
+  InitialStateEstimate out;
+  out.initial = options.initial;
+  segment = std::clamp<std::size_t>(segment, 2, options.time.size());
+  out.segment = segment;
+  if (options.time.size() < 2) return out;
+  StartProblem problem(normalized, form, options, recorded, segment);
+  Eigen::VectorXd x = problem.vector_of(options.initial), r, trial_r, shifted_r;
+  out.initial = problem.map_of(x);
+  if (!problem.residuals(x, r)) {  // the guess itself cannot be run: the full run will say why
+    out.cost_before = out.cost_after = INFINITY;
+    return out;
+  }
+  double cost = r.squaredNorm();
+  out.cost_before = cost;
+  const auto n = static_cast<Eigen::Index>(problem.size());
+  Eigen::MatrixXd J(r.size(), n);
+  double lambda = 1e-3;
+  for (int iteration = 0; iteration < kMaxIterations && cost > 0; ++iteration) {
+    // Forward differences: RK4 on a fixed grid is a smooth function of the start (linear for a
+    // linear model), so a relative step of 1e-7 loses only the digits that step costs.
+    bool sensitivities = true;
+    for (Eigen::Index k = 0; k < n && sensitivities; ++k) {
+      double h = 1e-7 * (std::abs(x(k)) + problem.typical(static_cast<std::size_t>(k)));
+      Eigen::VectorXd shifted = x;
+      shifted(k) += h;
+      if (!problem.residuals(shifted, shifted_r)) {  // the other side, when that direction diverges
+        h = -h;
+        shifted(k) = x(k) + h;
+        sensitivities = problem.residuals(shifted, shifted_r);
+      }
+      if (sensitivities) J.col(k) = (shifted_r - r) / h;
+    }
+    if (!sensitivities) break;
+    const Eigen::MatrixXd normal = J.transpose() * J;
+    const Eigen::VectorXd gradient = J.transpose() * r;
+    const double largest = normal.diagonal().maxCoeff();
+    if (!(largest > 0)) break;  // the segment does not depend on the start
+    bool accepted = false;
+    double trial_cost = cost;
+    for (int attempt = 0; attempt < kMaxDampingTries && !accepted; ++attempt) {
+      Eigen::MatrixXd damped = normal;
+      for (Eigen::Index k = 0; k < n; ++k) damped(k, k) += lambda * std::max(normal(k, k), 1e-12 * largest);
+      const Eigen::VectorXd step = damped.ldlt().solve(-gradient);
+      const Eigen::VectorXd trial = x + step;
+      if (step.allFinite() && problem.residuals(trial, trial_r) && (trial_cost = trial_r.squaredNorm()) < cost) {
+        accepted = true;
+        x = trial;
+        r = trial_r;
+        lambda = std::max(lambda / 10, 1e-12);
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!accepted) break;
+    ++out.iterations;
+    const double decrease = cost - trial_cost;
+    cost = trial_cost;
+    if (decrease <= 1e-10 * cost) break;  // converged: a further step would change nothing visible
+  }
+  out.initial = problem.map_of(x);
+  out.cost_after = cost;
+  return out;
+}
+
+}  // namespace sidc

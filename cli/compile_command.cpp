@@ -66,6 +66,8 @@ std::string summary(const ir::Model& m, const std::string& path) {
     if (n > 0) out += fmt::format("# equation {} integrated {} time{} from t0 to t\n", i + 1, n, n == 1 ? "" : "s");
   }
   if (!constants.empty()) out += "# integration constants: " + constants + "\n";
+  if (m.form_from_data)
+    out += "# no form named: `sidc fit` chooses weak, derivative or integrated from the data (`set form` names one); printed: the derivative form\n";
   return out;
 }
 

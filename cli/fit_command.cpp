@@ -14,11 +14,13 @@
 #include "cli/exit_codes.hpp"
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
+#include "compiler/pipeline.hpp"
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/queries.hpp"
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
+#include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/model_comparison.hpp"
@@ -60,12 +62,33 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   auto compiled = load_compiled_model(compiled_path, error, warnings);
   std::cerr << warnings;
   if (!compiled) return fail(error, exit_code::user_error);
-  const ir::Model& model = compiled->integrated;
-  auto options = fit_options(model, a.records, error);
+  auto options = fit_options(compiled->integrated, a.records, error);
   if (!options) return fail(error, exit_code::usage_error);
   auto loaded = load_records(*compiled, compiled_path, a.records, error);
   if (!loaded) return fail(error, exit_code::user_error);
   const std::vector<SampledRecord>& records = loaded->records;
+  std::string form_report;
+  if (compiled->integrated.form_from_data) {
+    // The model names no form: each is fitted and the one whose solved equations follow the record
+    // best is kept (form_choice.hpp). Without validation there is nothing to judge them by.
+    // Ties go to the first: the weak form, the most accurate on known-truth records (docs/accuracy.md).
+    static const std::vector<std::string> forms{"weak", "derivative", "integrated"};
+    std::vector<ir::Model> rewritten;
+    for (const auto& f : forms) rewritten.push_back(rewritten_in_form(compiled->normalized, f));
+    std::size_t chosen = 0;
+    if (a.no_validate) {
+      form_report = "form: weak, the most accurate on known-truth records (docs/accuracy.md); the model sets none, and with\n"
+                    "--no-validate there is no simulation to choose one by\n";
+    } else {
+      std::vector<FormCandidate> candidates;
+      for (std::size_t i = 0; i < forms.size(); ++i) candidates.push_back({forms[i], &rewritten[i]});
+      const FormChoice choice = choose_form(candidates, compiled->normalized, *compiled->explicit_form, records, *options, a.validate_samples);
+      chosen = choice.chosen;
+      form_report = choice.report();
+    }
+    compiled->integrated = std::move(rewritten[chosen]);
+  }
+  const ir::Model& model = compiled->integrated;
 
   auto result = fit(model, records, *options);
   if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
@@ -74,7 +97,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (const auto& w : r.warnings) std::cerr << render(w) << "\n";
   for (const auto& g : summary.groups)
     for (const auto& warning : drift_warnings(model, g.drift)) std::cerr << render(warning) << "\n";
-  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << operator_report(summary.operators, options->evaluation);
+  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << form_report << (form_report.empty() ? "" : "\n")
+            << operator_report(summary.operators, options->evaluation);
   if (!is_static(model)) std::cout << "\n";
   std::cout << summary.full_report(model);
 

@@ -3,12 +3,15 @@
 // (`sidc compile --dump-after=PASS`).
 #include "compiler/pipeline.hpp"
 
+#include <algorithm>
+
 #include "compiler/declare_pass.hpp"
 #include "compiler/explicit_form_pass.hpp"
 #include "compiler/lower_pass.hpp"
 #include "compiler/normalize_pass.hpp"
 #include "compiler/weak_pass.hpp"
 #include "ir/print.hpp"
+#include "ir/queries.hpp"
 
 namespace sidc {
 
@@ -45,6 +48,11 @@ CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOpt
   r.integrated = integrate_pass(*r.normalized, options.integrate, r.diagnostics);
   if (stop("integrate")) return r;
   r.integrated = weak_pass(std::move(*r.integrated), r.diagnostics);
+  // Nothing names a form (`set constants` alone does not): the fit chooses it from the data.
+  const bool named = options.integrate.override_request ||
+                     std::any_of(r.normalized->equations.begin(), r.normalized->equations.end(),
+                                 [](const ir::Equation& e) { return e.integration.span.known(); });
+  r.integrated->form_from_data = !named && !is_static(*r.integrated);
   stop("weak");
   return r;
 }
@@ -53,6 +61,18 @@ CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOpt
 // integration, and its failure is no compile error: a model that cannot be solved can still be fitted.
 CompiledModel compiled_model(std::shared_ptr<const SourceFile> source, const ir::Model& normalized, const ir::Model& integrated) {
   return CompiledModel{std::move(source), normalized, integrated, explicit_form(normalized)};
+}
+
+ir::Model rewritten_in_form(const ir::Model& normalized, const std::string& form) {
+  IntegrateOptions options;
+  ir::IntegrationRequest request;
+  request.weak = form == "weak";
+  if (form == "integrated") request.count = ir::IntegrationRequest::Count::automatic;
+  options.override_request = request;
+  Diagnostics ignored;  // the same passes accepted this model when it was compiled
+  ir::Model m = weak_pass(integrate_pass(normalized, options, ignored), ignored);
+  m.form_from_data = false;
+  return m;
 }
 
 std::optional<CompiledModel> read_compiled_model(const nlohmann::ordered_json& j, const std::string& path, std::string& error) {

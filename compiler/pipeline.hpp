@@ -43,6 +43,11 @@ CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOpt
 // (explicit_form_pass), derived once here for every command that solves the equations.
 CompiledModel compiled_model(std::shared_ptr<const SourceFile> source, const ir::Model& normalized, const ir::Model& integrated);
 
+// The equations of `normalized` rewritten into `form` (`derivative`, `integrated` or `weak`), as
+// `sidc compile --form` rewrites them: the candidates of sidc fit's choice of form when the model
+// names none (runtime/simulate/form_choice.hpp).
+ir::Model rewritten_in_form(const ir::Model& normalized, const std::string& form);
+
 // A compiled model file read back (ir/compiled_model.hpp), its explicit form derived again (the file
 // does not hold it); nullopt with `error` naming what is wrong.
 std::optional<CompiledModel> read_compiled_model(const nlohmann::ordered_json& j, const std::string& path, std::string& error);

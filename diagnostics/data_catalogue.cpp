@@ -222,8 +222,9 @@ Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int orde
   Diagnostic d;
   d.code = "data-empty-fit-window";
   d.message = fmt::format("no samples of `{}` are left in the fit window", path);
-  d.hint = fmt::format("the record has {} samples; derivatives of order {} lose {} at each edge{}", samples, order, margin,
-                       cut_by_window ? ", and `from`/`to` cut it further" : "");
+  d.hint = order == 0 ? fmt::format("the record has {} samples{}", samples, cut_by_window ? "; `from`/`to` leave none of them" : "")
+                      : fmt::format("the record has {} samples; derivatives of order {} lose {} at each edge{}", samples, order, margin,
+                                    cut_by_window ? ", and `from`/`to` cut it further" : "");
   return d;
 }
 

@@ -296,6 +296,7 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
   j["plots"] = plots_json(m);
   j["normalized"] = model_json(c.normalized);
   j["equations"] = model_json(m);
+  if (m.form_from_data) j["form_from_data"] = true;  // written only when set: other files stay as they were
   return j;
 }
 
@@ -378,6 +379,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
     m.plots = normalized.plots;
     normalized.equations = read_equations(j.at("normalized"), normalized, r);
     m.equations = read_equations(j.at("equations"), m, r);
+    m.form_from_data = j.value("form_from_data", false);
     c.normalized = std::move(normalized);
     return c;
   } catch (const std::exception& ex) {

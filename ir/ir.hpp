@@ -205,6 +205,9 @@ struct PlotFunction {
 };
 
 struct Model {
+  // No equation names its form (`set form`, `set integrate`, `--form`, `--integrate`) and the model
+  // is dynamic: `sidc fit` chooses the form from the data (runtime/simulate/form_choice.hpp).
+  bool form_from_data = false;
   std::string name;
   Span name_span;
   std::vector<Signal> signals;

@@ -19,7 +19,7 @@ run_example() {  # folder, model, step number
   local folder=$1 model=$2 step=$3
   local out="$pictures/$folder"
   cd "$repo_root/examples/$folder"
-  echo "demo.sh: step $step of 3: sidc compile $model && sidc fit --plots $out (in examples/$folder)"
+  echo "demo.sh: step $step of 4: sidc compile $model && sidc fit --plots $out (in examples/$folder)"
   "$sidc" compile "$model"
   rm -rf "$out"
   "$sidc" fit --plots "$out" --report "$out/report.html"
@@ -27,4 +27,5 @@ run_example() {  # folder, model, step number
 run_example thesis-4-1 quasi_linear.sid 1
 run_example thesis-4-2 process.sid 2
 run_example silverbox derivative_form.sid 3
-echo "demo.sh: pictures and one-page reports in $pictures/{thesis-4-1,thesis-4-2,silverbox}/"
+run_example noisy-duffing duffing.sid 4
+echo "demo.sh: pictures and one-page reports in $pictures/{thesis-4-1,thesis-4-2,silverbox,noisy-duffing}/"

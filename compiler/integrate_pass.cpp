@@ -175,9 +175,12 @@ struct Integrator {
 
   ir::Equation integrate(const ir::Equation& e, std::size_t index) {
     const auto& r = e.integration;
-    if (r.weak) return e;  // weak_pass's to rewrite
     const bool dynamic = is_dynamic(e.known) || std::any_of(e.terms.begin(), e.terms.end(),
                                                             [](const ir::ParameterTerm& p) { return is_dynamic(p.operation); });
+    if (r.weak) {  // weak_pass's to rewrite, when there is something to integrate
+      if (!dynamic) diagnostics.add(diag::static_model_weak(e.span));
+      return e;
+    }
     int times = r.times;
     if (r.count == ir::IntegrationRequest::Count::automatic) {
       // The smallest N that leaves the fewest derivatives to estimate (4-1.8 -> once, 2-2.6 -> twice).

@@ -69,7 +69,9 @@ ir::Model rewritten_in_form(const ir::Model& normalized, const std::string& form
   request.weak = form == "weak";
   if (form == "integrated") request.count = ir::IntegrationRequest::Count::automatic;
   options.override_request = request;
-  Diagnostics ignored;  // the same passes accepted this model when it was compiled
+  // The model compiled without a request; integrate and weak add no error to a dynamic model's
+  // normalized form (form_from_data is set only for those).
+  Diagnostics ignored;
   ir::Model m = weak_pass(integrate_pass(normalized, options, ignored), ignored);
   m.form_from_data = false;
   return m;

@@ -358,6 +358,12 @@ Diagnostic static_model_integrated(const Span& where, int times) {
                "integration rewrites differential equations (thesis section 2-2); use `--integrate 0` for a static model");
 }
 
+Diagnostic static_model_weak(const Span& where) {
+  return error("static-model-weak", where, "cannot write this equation in weak form: it has no derivative, integral or time in it",
+               "the weak form integrates differential equations against test functions over time; use `set form = derivative` "
+               "(or no `set form`) for a static model");
+}
+
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes) {
   std::string hint = did_you_mean(nearest);
   return error("unknown-pass", {}, fmt::format("unknown pass `{}`", name),

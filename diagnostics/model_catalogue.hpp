@@ -122,6 +122,7 @@ Diagnostic input_definition_uses_signal(const Span& where, std::string_view inpu
 Diagnostic binding_unknown_signal(const Span& where, std::string_view name, std::string_view nearest);
 Diagnostic binding_repeated(const Span& where, std::string_view name);
 Diagnostic binding_of_defined_input(const Span& where, std::string_view name);
+Diagnostic static_model_weak(const Span& where);
 Diagnostic static_model_integrated(const Span& where, int times);
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes);
 Diagnostic integrate_option_invalid(std::string_view value);

@@ -244,14 +244,52 @@ std::vector<ir::Equation> read_equations(const json& j, const ir::Model& m, cons
                                                                                            : ir::IntegrationRequest::Constants::fitted;
     eq.terms = read_operations(e.at("operations"), m, r);
     eq.known = r.sum(e.at("known"));
-    // Test functions are the weak form's alone: elsewhere nothing would integrate them away.
-    const auto test_function = [](const ir::Factor& f) { return f.kind == FactorKind::test_function; };
-    const bool has_test_function = ir::any_factor(eq.known, test_function) ||
-        std::any_of(eq.terms.begin(), eq.terms.end(), [&](const ir::ParameterTerm& p) { return ir::any_factor(p.operation, test_function); });
-    if (has_test_function && !eq.weak) throw std::runtime_error("a test function `phi_j` in an equation that is not of the weak form");
     equations.push_back(std::move(eq));
   }
   return equations;
+}
+
+// Test functions belong to the weak form's fitted equations alone, one on every term, at its top,
+// to the power 1, of an order the weak form can reach: elsewhere nothing would integrate them away.
+void check_test_functions(const ir::Model& m, const ir::Model& normalized) {
+  const auto is_test_function = [](const ir::Factor& f) { return f.kind == FactorKind::test_function; };
+  const auto none = [&](const ir::Sum& s, const std::string& where) {
+    if (ir::any_factor(s, is_test_function)) throw std::runtime_error("a test function `phi_j` in " + where);
+  };
+  for (const auto& e : normalized.equations) {
+    none(e.known, "the normalized equations");
+    for (const auto& p : e.terms) none(p.operation, "the normalized equations");
+  }
+  if (m.weights) none(m.weights->value, "the weights");
+  for (const auto& s : m.signals)
+    if (s.definition) none(*s.definition, "the definition of `" + s.name + "`");
+  for (const auto& p : m.plots) {
+    none(p.rest, "plot `" + p.name + "`");
+    if (p.truth) none(*p.truth, "plot `" + p.name + "`");
+    for (const auto& t : p.terms) none(t.operation, "plot `" + p.name + "`");
+  }
+  for (const auto& e : m.equations) {
+    std::vector<const ir::Sum*> sums{&e.known};
+    for (const auto& p : e.terms) sums.push_back(&p.operation);
+    for (const ir::Sum* s : sums) {
+      if (!e.weak) {
+        none(*s, "an equation that is not of the weak form");
+        continue;
+      }
+      for (const auto& t : s->terms) {
+        int found = 0;
+        ir::Term rest = t;
+        std::erase_if(rest.factors, [&](const auto& f) {
+          if (f.first.kind != FactorKind::test_function) return false;
+          if (f.second != 1 || f.first.order > kMaxWeakOrder) throw std::runtime_error("a test function of a power or order the weak form never writes");
+          ++found;
+          return true;
+        });
+        if (found != 1) throw std::runtime_error("a term of a weak-form equation without exactly one test function `phi_j`");
+        none(ir::Sum{{rest}}, "the argument of a function, power, derivative, integral or guard");
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -380,6 +418,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
     normalized.equations = read_equations(j.at("normalized"), normalized, r);
     m.equations = read_equations(j.at("equations"), m, r);
     m.form_from_data = j.value("form_from_data", false);
+    check_test_functions(m, normalized);
     c.normalized = std::move(normalized);
     return c;
   } catch (const std::exception& ex) {

@@ -21,6 +21,9 @@
 namespace sidc {
 
 inline constexpr int kCompiledModelVersion = 2;
+// The highest derivative order a compiled model's test function may carry: a file asking for more
+// is refused (its quadrature weights, scaled by h^-k, would overflow long before).
+inline constexpr int kMaxWeakOrder = 16;
 
 struct CompiledModel {
   std::shared_ptr<const SourceFile> source;

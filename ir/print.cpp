@@ -212,8 +212,7 @@ std::string print(const ir::Model& m) {
   for (const auto& e : m.equations) {
     const auto& r = e.integration;
     if (r.weak && !current.weak) out += "set form = weak\n";
-    if (e.weak && (&e == &m.equations.front() || !(&e - 1)->weak))
-      out += "# weak form: each equation below holds integrated against every test function phi_j over its subdomain\n";
+    if (e.weak) out += "# weak form: the equation below holds integrated against every test function phi_j over its subdomain\n";
     if (!r.weak && (r.count != current.count || r.times != current.times || current.weak))
       out += fmt::format("set integrate = {}\n", r.count == ir::IntegrationRequest::Count::automatic ? "auto" : std::to_string(r.times));
     if (r.constants != current.constants)

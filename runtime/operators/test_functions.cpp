@@ -97,13 +97,13 @@ Spectrum spectrum_of(std::span<const double> values, double step) {
   for (std::size_t f = power.size() - 1; f >= 1; --f) {
     double sum = 0;
     int count = 0;
-    for (std::size_t g = f >= 2 ? f - 2 : 1; g <= std::min(power.size() - 1, f + 2); ++g) sum += power[g], ++count;
+    for (std::size_t g = f >= 3 ? f - 2 : 1; g <= std::min(power.size() - 1, f + 2); ++g) sum += power[g], ++count;
     if (sum / count > kAboveFloor * floor && sum > 0) {
       Spectrum s;
       s.corner = static_cast<double>(f) / (static_cast<double>(L) * step);
       double power_below = 0, moment = 0;
       for (std::size_t g = 1; g <= f; ++g) power_below += power[g], moment += power[g] * static_cast<double>(g);
-      s.centroid = moment / power_below / (static_cast<double>(L) * step);
+      s.centroid = power_below > 0 ? moment / power_below / (static_cast<double>(L) * step) : s.corner;
       return s;
     }
   }

@@ -12,7 +12,8 @@
 // standard deviation h / sqrt(2p), is made to pass what lies below f_c and cut what lies above,
 // its transform falling to e^-2 at f_c: h = sqrt(2p) / (pi f_c). On a noise-free record f_c is
 // where the spectrum meets the rounding floor, the subdomains are as narrow as the quadrature
-// allows, and the weak equation is the derivative form's, integrated exactly. Subdomains overlap:
+// allows, and the weak equation is the derivative form's, integrated exactly; the half-width is
+// then at least a quarter period of the outputs' mean frequency (the support half a period). Subdomains overlap:
 // one starts every m/4 samples, so the rows cover the record evenly.
 #pragma once
 

@@ -102,13 +102,13 @@ std::string FormChoice::report() const {
   std::string out = fmt::format(
       "form chosen from the data (the model sets none): each form fitted, its equations solved from an estimated initial state\n"
       "{} and compared with it (fit % of the simulated outputs: the worst output{});\n"
-      "the first is kept unless another simulates better on every piece\n",
-      pieces > 1 ? fmt::format("on each of {} pieces of the record", pieces) : std::string("over the whole record (too short to cut)"),
+      "the first is kept unless another simulates better on every piece (if the first fails, the best of the others)\n",
+      pieces > 1 ? fmt::format("on each of {} pieces of the records", pieces) : std::string("over the whole record (too short to cut)"),
       pieces > 1 ? " and piece" : "");
   for (std::size_t i = 0; i < scores.size(); ++i) {
     const auto& s = scores[i];
     out += fmt::format("  {:<11} {:>10}   {}{}{}\n", s.name, s.worst_fit_percent ? fmt::format("{:.2f}%", *s.worst_fit_percent) : "-",
-                       i > 0 && s.worst_fit_percent ? fmt::format("better on {} of {} piece{}", s.better_pieces, s.pieces, s.pieces == 1 ? "" : "s") : "", s.note,
+                       i > 0 && s.worst_fit_percent && scores[0].worst_fit_percent ? fmt::format("better on {} of {} piece{}", s.better_pieces, s.pieces, s.pieces == 1 ? "" : "s") : "", s.note,
                        i == chosen ? "   <- chosen" : "");
   }
   return out;

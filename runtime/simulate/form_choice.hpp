@@ -9,7 +9,9 @@
 // t0, test-function integrals, whose own residuals cannot be compared), and it is the one that
 // matters to the user. The first candidate (sidc fit puts the weak form first, the most accurate on
 // known-truth records, docs/accuracy.md) is kept unless another simulates better on every piece: a
-// sign test, passed by chance with probability 2^-5 = 3%. A single whole-record comparison is not
+// sign test, passed by chance with probability 2^-5 = 3% for one alternative (about 6% for the
+// two, and more since neighbouring pieces are not quite independent); if the first cannot be
+// fitted or simulated, the best of the others by total error. A single whole-record comparison is not
 // enough: on the benchmark's pendulum with Coulomb friction a derivative-form fit 5.5% off simulated
 // the clean record at 99.61% against 99.47% for the weak form's, 0.4% off. Records shorter than
 // kPieces * kShortestPiece samples are compared whole (any improvement then counts). A candidate

@@ -17,6 +17,13 @@ ResidualAnalysis analyse_residuals(const ir::Model& model, const FitSummary& sum
   ResidualAnalysis out;
   const auto inputs = input_names(model);
   for (std::size_t g = 0; g < summary.groups.size(); ++g) {
+    if (!summary.groups[g].subdomains.empty()) {  // weak_design.hpp
+      out.groups.emplace_back();
+      out.notes.push_back("not computed: the weak form's rows are overlapping subdomains, their residuals correlated by construction, "
+                          "so a whiteness test says nothing about the model");
+      out.truncated.push_back(false);
+      continue;
+    }
     const GroupResiduals segments = group_residuals(model, records, options, summary, g, inputs, kMaxResidualRows);
     out.truncated.push_back(segments.truncated);
     if (!segments.ok) {

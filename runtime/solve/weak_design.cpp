@@ -127,8 +127,13 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
     for (double v : phi) total_phi += v;
     for (Eigen::Index j = 0; j < K; ++j) {
       double s = 0;
-      for (std::size_t i = 0; i < phi.size(); ++i) s += phi[i] * sample_weight[grid.centres[static_cast<std::size_t>(j)] - grid.half_width + i];
-      row_weight(j) = s / total_phi;
+      bool masked = false;  // a sample weighted 0 (an outlier, a dropout) takes out every subdomain it lies in
+      for (std::size_t i = 0; i < phi.size(); ++i) {
+        const double w = sample_weight[grid.centres[static_cast<std::size_t>(j)] - grid.half_width + i];
+        masked = masked || w == 0.0;
+        s += phi[i] * w;
+      }
+      row_weight(j) = masked ? 0.0 : s / total_phi;
     }
   }
   WeakValues weak(evaluator, grid);

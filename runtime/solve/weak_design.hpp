@@ -6,7 +6,8 @@
 // chosen from the record, the quadrature weights). Guarantees: an operation sum_k phi_j^(k) * g_k
 // gives row j the value sum_k integral(phi_j^(k) * g_k), each g_k evaluated once per record; the
 // rows run record by record, equation by equation, subdomain centres increasing (the times given
-// are the centres); a weighted row (eq. 2-1.6) carries the phi-weighted mean of its samples' weights.
+// are the centres); a weighted row (eq. 2-1.6) carries the phi-weighted mean of its samples' weights,
+// or 0 when one of them is 0 (a masked sample takes out every subdomain it lies in).
 // The weak design has few rows (about 4 n / m), so it is always solved dense; its evaluation holds
 // each g_k on the whole window (memory linear in n).
 #pragma once

@@ -358,6 +358,18 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
       {"wrong version", [](json& j) { j["version"] = 1; }, {"m.sidc.json", "format 1", "reads format 2"}},
       {"version not a number", [](json& j) { j["version"] = "1"; }, {"m.sidc.json", "compile the model again"}},
       {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, {"unknown factor kind `spline`"}},
+      {"a test function outside the weak form", [&](json& j) { j[first_factor] = {{"kind", "test_function"}, {"order", 1}, {"power", 1}}; },
+       {"test function `phi_j`", "not of the weak form"}},
+      {"a weak equation's term without a test function", [](json& j) { j["equations"][0]["weak"] = true; },
+       {"without exactly one test function"}},
+      {"a test function of an order the weak form never writes", [&](json& j) {
+         j["equations"][0]["weak"] = true;
+         for (auto* s : {&j["equations"][0]["known"], &j["equations"][0]["operations"][0]["operation"]})
+           for (auto& t : (*s)["terms"]) t["factors"].push_back({{"kind", "test_function"}, {"order", 40}, {"power", 1}});
+       }, {"power or order the weak form never writes"}},
+      {"a test function in the normalized equations", [](json& j) {
+         j["normalized"][0]["known"]["terms"][0]["factors"].push_back({{"kind", "test_function"}, {"order", 0}, {"power", 1}});
+       }, {"test function `phi_j` in the normalized equations"}},
       {"missing field", [](json& j) { j["equations"][0].erase("known"); }, {"m.sidc.json", "known", "compile the model again"}},
       {"missing field deep down", [&](json& j) { j[first_factor].erase("power"); }, {"power"}},
       {"negative denominator", [&](json& j) { j[first_coefficient] = {{"num", 1}, {"den", -2}}; }, {"denominator"}},

@@ -129,9 +129,9 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
       double s = 0;
       bool masked = false;  // a sample weighted 0 (an outlier, a dropout) takes out every subdomain it lies in
       for (std::size_t i = 0; i < phi.size(); ++i) {
-        const double w = sample_weight[grid.centres[static_cast<std::size_t>(j)] - grid.half_width + i];
-        masked = masked || w == 0.0;
-        s += phi[i] * w;
+        const double weight = sample_weight[grid.centres[static_cast<std::size_t>(j)] - grid.half_width + i];
+        masked = masked || weight == 0.0;
+        s += phi[i] * weight;
       }
       row_weight(j) = masked ? 0.0 : s / total_phi;
     }

@@ -69,9 +69,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   const std::vector<SampledRecord>& records = loaded->records;
   std::string form_report;
   if (compiled->integrated.form_from_data) {
-    // The model names no form: each is fitted and the one whose solved equations follow the record
-    // best is kept (form_choice.hpp). Without validation there is nothing to judge them by.
-    // Ties go to the first: the weak form, the most accurate on known-truth records (docs/accuracy.md).
+    // The model names no form: each is fitted, and the weak form, the most accurate on known-truth
+    // records (docs/accuracy.md), is kept unless another's solved equations follow the record better
+    // on every piece of it (form_choice.hpp). Without validation there is nothing to judge them by.
     static const std::vector<std::string> forms{"weak", "derivative", "integrated"};
     std::vector<ir::Model> rewritten;
     for (const auto& f : forms) rewritten.push_back(rewritten_in_form(compiled->normalized, f));

@@ -34,7 +34,7 @@ Fit fit_on(Eigen::MatrixXd V, const Eigen::VectorXd& v) {
 Eigen::MatrixXd basis(const Eigen::VectorXd& s, int degree, const Eigen::MatrixXd& absorbed) {
   Eigen::MatrixXd V(s.size(), std::max(degree + 1, 0) + absorbed.cols());
   for (int k = 0; k <= degree; ++k) V.col(k) = k == 0 ? Eigen::VectorXd::Ones(s.size()) : Eigen::VectorXd(V.col(k - 1).cwiseProduct(s));
-  V.rightCols(absorbed.cols()) = absorbed;
+  if (absorbed.cols() > 0) V.rightCols(absorbed.cols()) = absorbed;  // a 0 x 0 "none" cannot be assigned to n x 0
   return V;
 }
 

@@ -68,6 +68,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   if (!loaded) return fail(error, exit_code::user_error);
   const std::vector<SampledRecord>& records = loaded->records;
   std::string form_report;
+  std::optional<FormChoice> choice;
   if (compiled->integrated.form_from_data) {
     // The model names no form: each is fitted, and the weak form, the most accurate on known-truth
     // records (docs/accuracy.md), is kept unless another's solved equations follow the record better
@@ -82,9 +83,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     } else {
       std::vector<FormCandidate> candidates;
       for (std::size_t i = 0; i < forms.size(); ++i) candidates.push_back({forms[i], &rewritten[i]});
-      const FormChoice choice = choose_form(candidates, compiled->normalized, *compiled->explicit_form, records, *options, a.validate_samples);
-      chosen = choice.chosen;
-      form_report = choice.report();
+      choice = choose_form(candidates, compiled->normalized, *compiled->explicit_form, records, *options, a.validate_samples);
+      chosen = choice->chosen;
+      form_report = choice->report();
     }
     compiled->integrated = std::move(rewritten[chosen]);
   }
@@ -124,7 +125,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   std::cout << residual_report(residuals);
 
   if (!out_dir.empty()) {
-    auto written = write_fit_files(out_dir, {*compiled, compiled_path, summary, *options, records, validation, residuals});
+    auto written = write_fit_files(out_dir, {*compiled, compiled_path, summary, *options, records, validation, residuals,
+                                             choice ? &*choice : nullptr});
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
     if (paths.size() == 3) std::cerr << "wrote " << paths[0] << ", " << paths[1] << " and " << paths[2] << "\n";

@@ -192,6 +192,16 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   auto json = fit_json(f.summary, f.compiled, f.compiled_path, f.options);
   if (f.validation) json["validation"] = validation_json(*f.validation);
   json["residual_analysis"] = residual_json(f.residuals);
+  nlohmann::ordered_json choice;  // null unless the form was chosen from the data
+  if (f.form_choice) {
+    nlohmann::ordered_json forms = nlohmann::ordered_json::array();
+    for (const auto& s : f.form_choice->scores)
+      forms.push_back({{"form", s.name},
+                       {"worst_fit_percent", s.worst_fit_percent ? nlohmann::ordered_json(*s.worst_fit_percent) : nlohmann::ordered_json(nullptr)},
+                       {"better_pieces", s.better_pieces}, {"pieces", s.pieces}, {"note", s.note}});
+    choice = {{"chosen", f.form_choice->scores[f.form_choice->chosen].name}, {"forms", std::move(forms)}};
+  }
+  json["form_choice"] = std::move(choice);
   const bool curves = f.validation && !f.validation->runs.empty();
   std::string why;
   std::optional<Diagnostic> problem;  // why the residual rows could not be had

@@ -15,6 +15,7 @@
 #include "diagnostics/diagnostic.hpp"
 #include "ir/compiled_model.hpp"
 #include "runtime/select/select.hpp"
+#include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/residual_analysis.hpp"
@@ -35,6 +36,9 @@ struct FitFiles {
   const std::vector<SampledRecord>& records;
   const std::optional<FitValidation>& validation;  // nullopt: --no-validate
   const ResidualAnalysis& residuals;
+  // The form chosen from the data (form_choice.hpp) when the model names none and validation ran;
+  // null otherwise (fit.json's `form_choice` is then null; each equation still gives its `form`).
+  const FormChoice* form_choice;
 };
 
 // Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating

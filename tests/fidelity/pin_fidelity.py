@@ -19,6 +19,10 @@ with tempfile.TemporaryDirectory() as work:
     if run.returncode != 0:
         sys.exit(f"{case}: sidc fit failed ({run.returncode}):\n{run.stderr}")
     fit = json.load(open(os.path.join(work, "fit", "fit.json")))
+    choice = fit.get("form_choice")  # the model names no form: fit.json must say how it was chosen
+    if not choice or choice["chosen"] not in [f["form"] for f in choice["forms"]] or len(choice["forms"]) != 3:
+        sys.exit(f"{case}: fit.json has no usable form_choice: {choice}")
+    print(f"{case}: form chosen from the data: {choice['chosen']}")
     worst, name = 0.0, None
     for group in fit["groups"]:
         for p in group["parameters"]:

@@ -15,6 +15,7 @@
 #include "grammar/ast_printer.hpp"
 #include "diagnostics/cli_catalogue.hpp"
 #include "diagnostics/model_catalogue.hpp"
+#include "ir/settings.hpp"
 
 namespace sidc {
 namespace {
@@ -95,8 +96,7 @@ int run_compile(const CompileArguments& a) {
   }
   if (!a.form.empty()) {  // the same request as --integrate, named by its form (CLI11 checked the value)
     ir::IntegrationRequest r;
-    r.weak = a.form == "weak";
-    if (a.form == "integrated") r.count = ir::IntegrationRequest::Count::automatic;
+    request_form(r, a.form);
     options.integrate.override_request = r;
   }
   const bool dumping = !a.dump.empty() || !a.dump_after.empty();

@@ -73,21 +73,20 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     // The model names no form: each is fitted, and the weak form, the most accurate on known-truth
     // records (docs/accuracy.md), is kept unless another's solved equations follow the record better
     // on every piece of it (form_choice.hpp). Without validation there is nothing to judge them by.
-    static const std::vector<std::string> forms{"weak", "derivative", "integrated"};
-    std::vector<ir::Model> rewritten;
-    for (const auto& f : forms) rewritten.push_back(rewritten_in_form(compiled->normalized, f));
-    std::size_t chosen = 0;
     if (a.no_validate) {
       form_report = "form: weak, the most accurate on known-truth records (docs/accuracy.md); the model sets none, and with\n"
                     "--no-validate there is no simulation to choose one by\n";
+      compiled->integrated = rewritten_in_form(compiled->normalized, "weak");
     } else {
+      static const std::vector<std::string> forms{"weak", "derivative", "integrated"};
+      std::vector<ir::Model> rewritten;
       std::vector<FormCandidate> candidates;
+      for (const auto& f : forms) rewritten.push_back(rewritten_in_form(compiled->normalized, f));
       for (std::size_t i = 0; i < forms.size(); ++i) candidates.push_back({forms[i], &rewritten[i]});
       choice = choose_form(candidates, compiled->normalized, *compiled->explicit_form, records, *options, a.validate_samples);
-      chosen = choice->chosen;
       form_report = choice->report();
+      compiled->integrated = std::move(rewritten[choice->chosen]);
     }
-    compiled->integrated = std::move(rewritten[chosen]);
   }
   const ir::Model& model = compiled->integrated;
 

@@ -145,9 +145,7 @@ struct Declarer {
     }
     if (key == "form") {  // the same request as `integrate`, named by its form
       current_integration.span = value_span;
-      current_integration.weak = s.value == "weak";
-      current_integration.count = s.value == "integrated" ? ir::IntegrationRequest::Count::automatic : ir::IntegrationRequest::Count::fixed;
-      current_integration.times = 0;
+      request_form(current_integration, s.value);
       return;
     }
     if (key == "integrate") {

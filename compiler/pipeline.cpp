@@ -12,6 +12,7 @@
 #include "compiler/weak_pass.hpp"
 #include "ir/print.hpp"
 #include "ir/queries.hpp"
+#include "ir/settings.hpp"
 
 namespace sidc {
 
@@ -66,8 +67,7 @@ CompiledModel compiled_model(std::shared_ptr<const SourceFile> source, const ir:
 ir::Model rewritten_in_form(const ir::Model& normalized, const std::string& form) {
   IntegrateOptions options;
   ir::IntegrationRequest request;
-  request.weak = form == "weak";
-  if (form == "integrated") request.count = ir::IntegrationRequest::Count::automatic;
+  request_form(request, form);
   options.override_request = request;
   // The model compiled without a request; integrate and weak add no error to a dynamic model's
   // normalized form (form_from_data is set only for those).

@@ -86,6 +86,12 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
   return r;
 }
 
+void request_form(ir::IntegrationRequest& request, const std::string& form) {
+  request.weak = form == "weak";
+  request.count = form == "integrated" ? ir::IntegrationRequest::Count::automatic : ir::IntegrationRequest::Count::fixed;
+  request.times = 0;
+}
+
 EvaluationSettings evaluation_settings(const ir::Settings& settings) {
   EvaluationSettings e;
   auto get = [&](const char* key) -> const std::string* {

@@ -43,6 +43,11 @@ struct EvaluationSettings {
   std::optional<std::string> weights;      // a record column weighting each row's residual (eq. 2-1.6)
 };
 
+// `form` (`derivative`, `integrated`, `weak`; check_setting has accepted it) as the integration
+// request it names: `integrate = 0`, `integrate = auto`, or the weak form. The request's constants
+// and span are left as they are. Shared by `set form`, `sidc compile --form` and sidc fit's choice.
+void request_form(ir::IntegrationRequest& request, const std::string& form);
+
 // Typed settings from checked raw values (check_setting has accepted every one).
 EvaluationSettings evaluation_settings(const ir::Settings& settings);
 // Reads `savgol(7, 3)` or `savgol(auto)`; nullopt if the text is not of that form with a valid

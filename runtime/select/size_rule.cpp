@@ -31,7 +31,7 @@ ElbowResult relative_g_elbow(const std::vector<double>& G, double share) {
   return result;
 }
 
-std::vector<double> polynomial_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int degree) {
+std::vector<double> polynomial_energy_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int degree) {
   const Eigen::Index n = values.rows(), p = values.cols();
   std::vector<double> share(static_cast<std::size_t>(p), std::numeric_limits<double>::quiet_NaN());
   if (n == 0) return share;
@@ -66,7 +66,7 @@ std::vector<double> operation_line_share(const Eigen::Ref<const Eigen::MatrixXd>
   // The I-th forward difference undoes I integrations up to a constant factor h^I and a shift of
   // half a step per integration, neither of which changes the share.
   for (int i = 0; i < integrations && d.rows() > 0; ++i) d = (d.bottomRows(d.rows() - 1) - d.topRows(d.rows() - 1)).eval();
-  return polynomial_share(d, 1);
+  return polynomial_energy_share(d, 1);
 }
 
 }  // namespace sidc

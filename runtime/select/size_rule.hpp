@@ -15,13 +15,13 @@
 //   after each step, left_k = log(G_k / G_p) / log(G_{k-1} / G_p), and the elbow: the first size
 //   whose step leaves at most `share` of the distance (in log G) that remained to G_p. Scale-free
 //   (G in any units, any n); NaN where the distance before the step is 0. Never throws.
-// - polynomial_share: the share of a column's energy (sum of squares, not centred) that a
+// - polynomial_energy_share: the share of a column's energy (sum of squares, not centred) that a
 //   polynomial of the given degree in t explains, 1 - RSS / sum v^2 (1 for a constant column, NaN
 //   for a zero one), on equally spaced samples (the records' time grid), by Householder QR of a
 //   Legendre basis. Not centred, because a drift absorber's danger is its mean: cos(theta) =
 //   1 - theta^2/2 is 99.99% constant when theta stays within 0.3 rad.
 // - operation_line_share: per column of an equation's rows integrated `integrations` times, the
-//   polynomial_share (degree 1) of its I-th difference, the operation before integration. Measured
+//   polynomial_energy_share (degree 1) of its I-th difference, the operation before integration. Measured
 //   there, the test does not depend on the record's length: on the integrated column itself every
 //   operation with a nonzero mean (y'^2, a damper's y'*[y' <= 0]) becomes a near-ramp on a long
 //   enough record, true operations included.
@@ -52,7 +52,7 @@ struct ElbowResult {
 ElbowResult relative_g_elbow(const std::vector<double>& G, double share = kElbowShare);
 
 // Per column of `values` (rows: equally spaced samples in time), the polynomial share.
-std::vector<double> polynomial_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int degree);
+std::vector<double> polynomial_energy_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int degree);
 std::vector<double> operation_line_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int integrations);
 
 }  // namespace sidc

@@ -295,17 +295,25 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   return std::nullopt;
 }
 
+// `set weights = <expression>` (eq. 2-1.6) on each record's window; empty when the model sets none.
+std::variant<std::vector<std::vector<double>>, Diagnostic> expression_weights_by_record(const ir::Model& model,
+                                                                                       std::vector<Evaluator>& evaluators) {
+  std::vector<std::vector<double>> out(model.weights ? evaluators.size() : 0);
+  for (std::size_t r = 0; r < out.size(); ++r) {
+    auto values = expression_weights(model, evaluators[r]);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    out[r] = std::get<std::vector<double>>(std::move(values));
+  }
+  return out;
+}
+
 // A group of weak-form equations (weak_design.hpp): always dense, one row per subdomain.
 std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vector<SampledRecord>& records,
                                          std::vector<Evaluator>& evaluators, const DesignBuilder& design, const FitOptions& options,
                                          GroupFit& g) {
-  std::vector<std::vector<double>> weights_of_expression(model.weights ? records.size() : 0);
-  for (std::size_t r = 0; r < weights_of_expression.size(); ++r) {
-    auto values = expression_weights(model, evaluators[r]);
-    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    weights_of_expression[r] = std::get<std::vector<double>>(std::move(values));
-  }
-  auto made = weak_design(model, records, evaluators, design, g.equations, weights_of_expression);
+  auto expression = expression_weights_by_record(model, evaluators);
+  if (auto* d = std::get_if<Diagnostic>(&expression)) return *d;
+  auto made = weak_design(model, records, evaluators, design, g.equations, std::get<std::vector<std::vector<double>>>(expression));
   if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
   WeakDesign& w = std::get<WeakDesign>(made);
   for (std::size_t r = 0; r < records.size(); ++r) {
@@ -409,12 +417,9 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(total_rows), static_cast<Eigen::Index>(g.columns.size()));
     Eigen::VectorXd b(static_cast<Eigen::Index>(total_rows));
     Eigen::VectorXd weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(total_rows));
-    std::vector<std::vector<double>> weights_of_expression(model.weights ? records.size() : 0);  // per record, on its window
-    for (std::size_t r = 0; r < weights_of_expression.size(); ++r) {
-      auto values = expression_weights(model, evaluators[r]);
-      if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-      weights_of_expression[r] = std::get<std::vector<double>>(std::move(values));
-    }
+    auto by_record = expression_weights_by_record(model, evaluators);
+    if (auto* d = std::get_if<Diagnostic>(&by_record)) return *d;
+    const auto& weights_of_expression = std::get<std::vector<std::vector<double>>>(by_record);  // per record, on its window
     g.row_equation.reserve(total_rows);
     g.row_record.reserve(total_rows);
     g.row_time.reserve(total_rows);

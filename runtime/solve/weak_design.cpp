@@ -25,34 +25,24 @@ std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
   return {order, rest};
 }
 
-int highest_test_function_order(const ir::Model& model, const std::vector<std::size_t>& equations) {
+int highest_test_function_order(const DesignBuilder& design) {
   int k = 0;
-  const auto visit = [&](const ir::Sum& s) {
-    ir::for_each_factor(s, [&](const ir::Factor& f) {
+  for (const ir::Sum* s : design.sums())
+    ir::for_each_factor(*s, [&](const ir::Factor& f) {
       if (f.kind == ir::FactorKind::test_function) k = std::max(k, f.order);
     });
-  };
-  for (std::size_t e : equations) {
-    visit(model.equations[e].known);
-    for (const auto& p : model.equations[e].terms) visit(p.operation);
-  }
   return k;
 }
 
 // The outputs the group's equations use: their spectrum sets the subdomains' width.
-std::set<std::string> outputs_used(const ir::Model& model, const std::vector<std::size_t>& equations) {
+std::set<std::string> outputs_used(const ir::Model& model, const DesignBuilder& design) {
   std::set<std::string> names;
-  const auto visit = [&](const ir::Sum& s) {
-    ir::for_each_factor(s, [&](const ir::Factor& f) {
+  for (const ir::Sum* s : design.sums())
+    ir::for_each_factor(*s, [&](const ir::Factor& f) {
       if (f.kind != ir::FactorKind::signal) return;
       const ir::Signal* signal = model.signal(f.name);
       if (signal && signal->kind == ir::Signal::Kind::output) names.insert(f.name);
     });
-  };
-  for (std::size_t e : equations) {
-    visit(model.equations[e].known);
-    for (const auto& p : model.equations[e].terms) visit(p.operation);
-  }
   return names;
 }
 
@@ -99,14 +89,14 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
                                                         const std::vector<std::size_t>& equations, std::span<const double> expression) {
   WeakDesign out;
   std::vector<std::vector<double>> values;
-  for (const auto& name : outputs_used(model, equations)) {
+  for (const auto& name : outputs_used(model, design)) {
     auto v = evaluator.evaluate_in_window(signal_sum(name), "the output `" + name + "`");
     if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
     values.push_back(std::get<std::vector<double>>(std::move(v)));
   }
   const std::vector<std::span<const double>> spans(values.begin(), values.end());
   const std::size_t fewest_rows = std::max<std::size_t>(20, 4 * design.columns().size());
-  auto chosen = choose_test_functions(spans, evaluator.window().size(), records[r].step, highest_test_function_order(model, equations),
+  auto chosen = choose_test_functions(spans, evaluator.window().size(), records[r].step, highest_test_function_order(design),
                                       fewest_rows, records[r].path);
   if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
   out.grids.push_back(std::get<TestFunctionGrid>(std::move(chosen)));

@@ -62,7 +62,7 @@ TEST(DriftTest, PolynomialShareOfLinesSinesAndConstants) {
   m.col(1) = sampled(n, [](double t) { return std::sin(2 * std::numbers::pi * t); });
   m.col(2) = Eigen::VectorXd::Constant(n, 7);
   m.col(3) = Eigen::VectorXd::Zero(n);
-  const auto share = polynomial_share(m, 2);
+  const auto share = polynomial_energy_share(m, 2);
   EXPECT_NEAR(share[0], 1, 1e-12);
   EXPECT_LT(share[1], 0.01);
   EXPECT_NEAR(share[2], 1, 1e-12);
@@ -88,7 +88,7 @@ TEST(DriftTest, ThePendulumsCosineIsAnAbsorberAndAHalfWaveDamperIsNot) {
   // On the integrated column itself the damper would pass for a drift absorber.
   Eigen::MatrixXd once(n, 1);
   once.col(0) = integrated(m.col(1));
-  EXPECT_GT(polynomial_share(once, 2)[0], 0.999);
+  EXPECT_GT(polynomial_energy_share(once, 2)[0], 0.999);
 }
 
 }  // namespace

@@ -151,7 +151,7 @@ void add_compile_command(CLI::App& app, int& exit_status) {
       ->check(CLI::IsMember({"derivative", "integrated", "weak"}))
       ->excludes(integrate);
   auto* dump = cmd->add_option("--dump", args->dump, "Print one stage instead of compiling: ast, normalized or integrated");
-  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, integrate, weak)")
+  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, integrate, weak, hold)")
       ->excludes(dump);
   cmd->callback([args, &exit_status] { exit_status = run_compile(*args); });
 }

@@ -13,6 +13,7 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/record_options.hpp"
+#include "compiler/hold_check_pass.hpp"
 #include "compiler/load_model.hpp"
 #include "compiler/pipeline.hpp"
 #include "diagnostics/cli_catalogue.hpp"
@@ -81,8 +82,16 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
       static const std::vector<std::string> forms{"weak", "derivative", "integrated"};
       std::vector<ir::Model> rewritten;
       std::vector<FormCandidate> candidates;
-      for (const auto& f : forms) rewritten.push_back(rewritten_in_form(compiled->normalized, f));
-      for (std::size_t i = 0; i < forms.size(); ++i) candidates.push_back({forms[i], &rewritten[i]});
+      // A form that leaves a derivative of a held input (the derivative form of `x'`) is no candidate.
+      std::vector<std::string> names;
+      Diagnostics held;
+      for (const auto& f : forms) {
+        ir::Model m = rewritten_in_form(compiled->normalized, f);
+        if (!hold_check_pass(m, held)) continue;
+        rewritten.push_back(std::move(m));
+        names.push_back(f);
+      }
+      for (std::size_t i = 0; i < names.size(); ++i) candidates.push_back({names[i], &rewritten[i]});
       choice = choose_form(candidates, compiled->normalized, *compiled->explicit_form, records, *options, a.validate_samples);
       form_report = choice->report();
       compiled->integrated = std::move(rewritten[choice->chosen]);

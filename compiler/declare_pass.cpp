@@ -61,6 +61,24 @@ struct Declarer {
       s.name = item.name.name;
       s.kind = d.kind == "input" ? ir::Signal::Kind::input : ir::Signal::Kind::output;
       s.span = where;
+      if (item.hold) {
+        const Span hold_at = span(*item.hold);
+        const auto hold = ir::hold_from(item.hold->name);
+        if (!hold) {
+          diagnostics.add(diag::unknown_hold(hold_at, s.name, item.hold->name));
+          continue;
+        }
+        if (s.kind == ir::Signal::Kind::output) {
+          diagnostics.add(diag::hold_on_output(hold_at, s.name, item.hold->name));
+          continue;
+        }
+        if (item.definition) {
+          diagnostics.add(diag::hold_on_defined_input(hold_at, s.name, item.hold->name));
+          continue;
+        }
+        s.hold = *hold;
+        s.hold_span = hold_at;
+      }
       if (item.definition) {
         if (s.kind == ir::Signal::Kind::output) {
           diagnostics.add(diag::bad_setting_value(where, "output", s.name + " = ...", "only names; an input may be given as an expression of t"));

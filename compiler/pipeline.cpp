@@ -7,6 +7,7 @@
 
 #include "compiler/declare_pass.hpp"
 #include "compiler/explicit_form_pass.hpp"
+#include "compiler/hold_check_pass.hpp"
 #include "compiler/lower_pass.hpp"
 #include "compiler/normalize_pass.hpp"
 #include "compiler/weak_pass.hpp"
@@ -24,6 +25,7 @@ const std::vector<PassInfo>& passes() {
       {"normalize", "the thesis' linear form sum a_k op_k = known; needs canonical sums to find like terms"},
       {"integrate", "integrated form (sections 2-1, 2-2); works on the linear form, one operation at a time"},
       {"weak", "weak form for the equations that ask for it; after integrate, which leaves them alone, and like it on the linear form"},
+      {"hold", "no derivative of a held or linear input is left; after the form passes, which integrate such derivatives away"},
   };
   return list;
 }
@@ -54,7 +56,10 @@ CompileResult compile(std::shared_ptr<const SourceFile> source, const CompileOpt
                      std::any_of(r.normalized->equations.begin(), r.normalized->equations.end(),
                                  [](const ir::Equation& e) { return e.integration.span.known(); });
   r.integrated->form_from_data = !named && !is_static(*r.integrated);
-  stop("weak");
+  if (stop("weak")) return r;
+  // A model whose form the fit chooses is checked in each candidate form there (fit_command.cpp).
+  if (!r.integrated->form_from_data) hold_check_pass(*r.integrated, r.diagnostics);
+  stop("hold");
   return r;
 }
 

@@ -364,6 +364,31 @@ Diagnostic static_model_weak(const Span& where) {
                "(or no `set form`) for a static model");
 }
 
+Diagnostic unknown_hold(const Span& where, std::string_view signal, std::string_view word) {
+  return error("unknown-hold", where, fmt::format("`{}` after the input `{}` is not a hold", word, signal),
+               "write `held` (each sample's value holds until the next), `linear` (straight between samples) or "
+               "`smooth` (the default); separate several signals with commas: `input x, u`");
+}
+
+Diagnostic hold_on_output(const Span& where, std::string_view signal, std::string_view word) {
+  return error("hold-on-output", where, fmt::format("the output `{}` cannot be `{}`", signal, word),
+               "a hold says how an input was applied between samples; outputs are smooth responses, estimated by "
+               "the moving arc. Declare the signal with `input` if the process was driven by it");
+}
+
+Diagnostic hold_on_defined_input(const Span& where, std::string_view signal, std::string_view word) {
+  return error("hold-on-defined-input", where, fmt::format("the input `{}` is given as an expression of t and cannot also be `{}`", signal, word),
+               "a hold applies to a recorded input's samples; drop the expression and bind `" + std::string(signal) +
+                   "` to a column of the record, or drop the hold");
+}
+
+Diagnostic derivative_of_held_input(const Span& where, std::string_view signal, std::string_view hold, std::string_view written) {
+  return error("derivative-of-held-input", where,
+               fmt::format("`{}` is a derivative of the {} input `{}`, which has none between samples to estimate", written, hold, signal),
+               "write the model in integrated or weak form (`set form = weak`, `set integrate = 1`), where the derivative "
+               "is integrated away exactly, or declare the input `smooth` if it really moved smoothly");
+}
+
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes) {
   std::string hint = did_you_mean(nearest);
   return error("unknown-pass", {}, fmt::format("unknown pass `{}`", name),

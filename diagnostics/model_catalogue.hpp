@@ -123,6 +123,12 @@ Diagnostic binding_unknown_signal(const Span& where, std::string_view name, std:
 Diagnostic binding_repeated(const Span& where, std::string_view name);
 Diagnostic binding_of_defined_input(const Span& where, std::string_view name);
 Diagnostic static_model_weak(const Span& where);
+// `input x held`: the word after a signal's name is not a hold, or sits on an output or on an
+// input given as an expression of t; a held or linear input's derivative left after the form pass.
+Diagnostic unknown_hold(const Span& where, std::string_view signal, std::string_view word);
+Diagnostic hold_on_output(const Span& where, std::string_view signal, std::string_view word);
+Diagnostic hold_on_defined_input(const Span& where, std::string_view signal, std::string_view word);
+Diagnostic derivative_of_held_input(const Span& where, std::string_view signal, std::string_view hold, std::string_view written);
 Diagnostic static_model_integrated(const Span& where, int times);
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes);
 Diagnostic integrate_option_invalid(std::string_view value);

@@ -110,9 +110,11 @@ struct ModelName : x3::position_tagged {
 };
 
 // One signal of an `input`/`output` declaration; an input may be given as an expression of t
-// (`input x = 60*sin(4*pi*t)`, as the thesis evaluated its excitation).
+// (`input x = 60*sin(4*pi*t)`, as the thesis evaluated its excitation) or carry how it was held
+// between samples (`input x held`; the word is checked by compiler/declare_pass.cpp).
 struct SignalItem : x3::position_tagged {
   Identifier name;
+  std::optional<Identifier> hold;
   std::optional<Expression> definition;
 };
 

@@ -324,8 +324,9 @@ auto const model_statement_assembled_def = (keyword("model") > model_name)[assig
 
 auto const signal_kind_def = raw[lexeme[(lit("input") | lit("output")) >> !name_char]];
 auto const signal_name_def = identifier;
-// `input x = 60*sin(4*pi*t)`: an input given as an expression of t.
-auto const signal_item_def = signal_name >> -(lit('=') > expression);
+// `input x = 60*sin(4*pi*t)`: an input given as an expression of t; `input x held`: how a recorded
+// input was held between its samples.
+auto const signal_item_def = signal_name >> -identifier >> -(lit('=') > expression);
 auto const signal_items_def = signal_item >> *(lit(',') > signal_item);
 auto const signal_declaration_def = signal_kind > signal_items;
 

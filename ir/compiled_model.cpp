@@ -309,9 +309,13 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
   j["source"] = {{"path", c.source->name}, {"hash", source_hash(c.source->text)}, {"text", c.source->text}};
   j["model"] = m.name;
   ordered signals = ordered::array();
-  for (const auto& s : m.signals)
-    signals.push_back(ordered{{"name", s.name}, {"kind", s.kind == ir::Signal::Kind::input ? "input" : "output"},
-                              {"definition", s.definition ? sum_json(*s.definition) : ordered(nullptr)}, {"span", span_json(s.span)}});
+  for (const auto& s : m.signals) {
+    ordered signal{{"name", s.name}, {"kind", s.kind == ir::Signal::Kind::input ? "input" : "output"},
+                   {"definition", s.definition ? sum_json(*s.definition) : ordered(nullptr)}, {"span", span_json(s.span)}};
+    // Written only when not smooth, so that files of models without held inputs stay as they were.
+    if (s.hold != ir::Signal::Hold::smooth) signal["hold"] = to_string(s.hold);
+    signals.push_back(std::move(signal));
+  }
   j["signals"] = std::move(signals);
   ordered parameters = ordered::array();
   for (const auto& p : m.parameters)
@@ -363,6 +367,11 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       sig.span = r.span(s.at("span"));
       sig.used = true;
       if (!s.at("definition").is_null()) sig.definition = r.sum(s.at("definition"));
+      if (s.contains("hold")) {
+        sig.hold = *ir::hold_from(one_of(s, "hold", {"smooth", "held", "linear"}));
+        if (sig.kind != ir::Signal::Kind::input || sig.definition)
+          throw std::runtime_error("the signal `" + sig.name + "` has a hold but is not a recorded input");
+      }
       m.signals.push_back(std::move(sig));
     }
     for (const auto& p : j.at("parameters")) {

@@ -130,6 +130,21 @@ const char* to_string(Relation r) {
   return "<";
 }
 
+const char* to_string(Signal::Hold h) {
+  switch (h) {
+    case Signal::Hold::smooth: return "smooth";
+    case Signal::Hold::held: return "held";
+    case Signal::Hold::linear: return "linear";
+  }
+  return "smooth";
+}
+
+std::optional<Signal::Hold> hold_from(std::string_view word) {
+  for (auto h : {Signal::Hold::smooth, Signal::Hold::held, Signal::Hold::linear})
+    if (word == to_string(h)) return h;
+  return std::nullopt;
+}
+
 int highest_derivative_order(const Sum& s) {
   int k = 0;
   walk_factors(s, [&](const Factor& f, const Term&) {

@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ir/number.hpp"
@@ -116,7 +117,18 @@ struct Signal {
   Span span;
   std::optional<Sum> definition;  // an input given as an expression of t
   bool used = false;
+  // How a recorded input moved between its samples (thesis section 4-2: a controller or a test
+  // engineer sets a value and holds it). `smooth`: as a smooth curve through the samples (the
+  // moving arc, Simpson's rule, the cubic of simulation); `held`: each sample's value holds until
+  // the next (zero-order hold); `linear`: straight between samples (first-order hold). Integrals
+  // of held and linear inputs are exact on each sample interval (runtime/operators/piecewise_inputs.hpp).
+  enum class Hold { smooth, held, linear };
+  Hold hold = Hold::smooth;
+  Span hold_span;
 };
+
+const char* to_string(Signal::Hold h);  // "smooth", "held", "linear"
+std::optional<Signal::Hold> hold_from(std::string_view word);
 
 struct Parameter {
   enum class Origin { declared, implicit, integration_constant };

@@ -284,6 +284,15 @@ Diagnostic operation_not_finite(const Span& where, std::string_view operation, s
                "check the record there (a zero under a division or a log, a huge power), or narrow the fit window with `set from`/`set to`");
 }
 
+Diagnostic held_input_integral_unsupported(const Span& where, std::string_view term, std::string_view input) {
+  return error("held-input-integral-unsupported", where,
+               fmt::format("cannot integrate `{}` exactly: it multiplies an integral of the held input `{}` by something that varies "
+                           "within a sample interval",
+                           term, input),
+               "sidc integrates a held input's pieces exactly, and integrals of them times a constant; write the model in weak form "
+               "(`set form = weak`), which needs no nested integral, or declare the input `smooth`");
+}
+
 Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record) {
   return error("initial-value-unavailable", where, fmt::format("`{}` has no value at t = {} in `{}`", value, time, record),
                "a derivative has no estimate near the edges of the record under `edges = drop`; use a later time or `set edges = shorten`");

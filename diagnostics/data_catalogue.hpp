@@ -84,6 +84,9 @@ namespace sidc::diag {
 
 // ---- evaluation on data (runtime/), pointing at the model term that asked for it
 Diagnostic operation_not_finite(const Span& where, std::string_view operation, std::string_view owner, double time, std::string_view record);
+// A term that holds a held or linear input both directly and inside an integral, or an integral
+// of one multiplied by a signal: runtime/operators/piecewise_inputs.hpp integrates neither exactly.
+Diagnostic held_input_integral_unsupported(const Span& where, std::string_view term, std::string_view input);
 Diagnostic initial_value_unavailable(const Span& where, std::string_view value, double time, std::string_view record);
 Diagnostic initial_value_outside_record(const Span& where, std::string_view value, double time, double first, double last);
 Diagnostic no_data_file(const Span& where);

@@ -1,13 +1,16 @@
 #include "runtime/operators/evaluate.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <fmt/format.h>
 
 #include "ir/queries.hpp"
 #include "ir/print.hpp"
+#include "ir/traversal.hpp"
 #include "diagnostics/data_catalogue.hpp"
+#include "runtime/operators/piecewise_inputs.hpp"
 #include <stdexcept>
 
 namespace sidc {
@@ -139,7 +142,7 @@ std::variant<FitWindow, Diagnostic> fit_window(const SampledRecord& record, cons
 }
 
 Evaluator::Evaluator(const SampledRecord& record, const ir::Model& model, const EvaluationOptions& options, FitWindow window)
-    : record_(record), model_(model), options_(options), window_(window) {}
+    : record_(record), model_(model), options_(options), window_(window), segmented_(has_piecewise_inputs(model)) {}
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::string& name, int order, const Span& where) {
   const auto key = std::pair{name, order};
@@ -219,6 +222,16 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
     case FactorKind::integral: {
       const std::string key = print(f);
       if (auto it = composite_.find(key); it != composite_.end()) return it->second;
+      if (f.kind == FactorKind::integral && segmented_) {
+        // Held or linear inputs: interval by interval within their segments (piecewise_inputs.hpp), from t0.
+        auto intervals = interval_integrals(*f.argument, 0);
+        if (auto* d = std::get_if<Diagnostic>(&intervals)) return *d;
+        const Values& q = std::get<Values>(intervals);
+        Values v(n, nan);
+        if (window_.size() > 0) v[window_.first] = 0;
+        for (std::size_t i = 0; i < q.size(); ++i) v[window_.first + i + 1] = v[window_.first + i] + q[i];
+        return composite_[key] = std::move(v);
+      }
       auto argument = evaluate(*f.argument);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
       const Values& a = std::get<Values>(argument);
@@ -254,6 +267,113 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
   // normalize_pass takes every parameter out of the operations, and the weak form's test functions
   // are integrated by runtime/solve/weak_design.cpp before evaluation; one here is a bug (exit code 3).
   throw std::logic_error(fmt::format("the factor `{}` reached the evaluator", print(f)));
+}
+
+struct Evaluator::Pieces {
+  std::array<SampledRecord, kPieceOffsets.size()> records;
+  std::vector<Evaluator> evaluators;  // one per record; they hold references into `records`
+};
+
+Evaluator& Evaluator::piece(int d) {
+  if (!pieces_) {
+    pieces_ = std::make_shared<Pieces>();
+    pieces_->evaluators.reserve(kPieceOffsets.size());
+    for (std::size_t k = 0; k < kPieceOffsets.size(); ++k) {
+      pieces_->records[k] = piece_record(record_, model_, kPieceOffsets[k]);
+      pieces_->evaluators.emplace_back(pieces_->records[k], model_, options_, window_);
+    }
+  }
+  return pieces_->evaluators[static_cast<std::size_t>(d - kPieceOffsets.front())];
+}
+
+bool Evaluator::holds_piecewise_input(const ir::Sum& s) const { return sidc::holds_piecewise_input(model_, s); }
+
+namespace {
+
+// The held or linear input a term holds, for messages.
+std::string piecewise_input_name(const ir::Model& model, const ir::Term& t) {
+  std::string name;
+  ir::any_factor(ir::canonical(std::vector<ir::Term>{t}), [&](const ir::Factor& f) {
+    if (f.kind == FactorKind::signal && piecewise_input(model, f.name)) name = f.name;
+    return !name.empty();
+  });
+  return name;
+}
+
+}  // namespace
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate_piece_in_window(const ir::Sum& s, int d, const std::string& what) {
+  for (const auto& t : s.terms)
+    if (has_piecewise_integral(model_, t))
+      return diag::held_input_integral_unsupported(t.span, print(ir::canonical(std::vector<ir::Term>{t})), piecewise_input_name(model_, t));
+  return piece(d).evaluate_in_window(s, what);
+}
+
+std::pair<int, int> Evaluator::interval_nodes(std::size_t k) {
+  if (boundaries_.empty()) boundaries_ = piece_boundaries(record_, model_);
+  const bool left = k > window_.first && !boundaries_[k];
+  const bool right = k + 2 <= window_.last && !boundaries_[k + 1];
+  return {left ? -1 : 0, right ? 2 : 1};
+}
+
+std::variant<std::vector<double>, Diagnostic> Evaluator::interval_integrals(const ir::Sum& s, int m) {
+  const std::size_t intervals = window_.size() > 0 ? window_.size() - 1 : 0;
+  const double h = record_.step;
+  double factorial = 1;
+  for (int j = 2; j <= m + 1; ++j) factorial *= j;
+  Values out(intervals, 0.0);
+  std::vector<ir::Term> smooth, held;  // evaluated once; on the piece records
+  for (const auto& t : s.terms) {
+    if (!has_piecewise_integral(model_, t)) {
+      (sidc::holds_piecewise_input(model_, ir::canonical(std::vector<ir::Term>{t})) ? held : smooth).push_back(t);
+      continue;
+    }
+    // c * F with F = int(g): int (t_{i+1} - s)^m / m! F = h^(m+1)/(m+1)! F(t_i) + int (t_{i+1} - s)^(m+1)/(m+1)! g.
+    const bool integral_alone = t.factors.size() == 1 && t.factors[0].second == 1 && t.factors[0].first.kind == FactorKind::integral;
+    if (!integral_alone)
+      return diag::held_input_integral_unsupported(t.span, print(ir::canonical(std::vector<ir::Term>{t})), piecewise_input_name(model_, t));
+    const ir::Factor& integral = t.factors[0].first;
+    auto values = factor(integral, t.span);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    auto inner = interval_integrals(*integral.argument, m + 1);
+    if (auto* d = std::get_if<Diagnostic>(&inner)) return *d;
+    const Values& F = std::get<Values>(values);
+    const Values& g = std::get<Values>(inner);
+    const double c = t.coefficient.value(), scale = std::pow(h, m + 1) / factorial;
+    for (std::size_t i = 0; i < intervals; ++i) out[i] += c * (scale * F[window_.first + i] + g[i]);
+  }
+  if ((smooth.empty() && held.empty()) || intervals == 0) return out;
+  // v[j][k]: the integrand at sample k as interval k - d sees it (d = kPieceOffsets[j]).
+  std::array<Values, kPieceOffsets.size()> v;
+  Values common(record_.time.size(), 0.0);
+  if (!smooth.empty()) {
+    auto values = evaluate(ir::canonical(std::move(smooth)));
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    common = std::get<Values>(std::move(values));
+  }
+  const ir::Sum held_part = ir::canonical(std::move(held));
+  for (std::size_t j = 0; j < kPieceOffsets.size(); ++j) {
+    v[j] = common;
+    if (held_part.empty()) continue;
+    auto values = piece(kPieceOffsets[j]).evaluate(held_part);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& p = std::get<Values>(values);
+    for (std::size_t k = 0; k < p.size(); ++k) v[j][k] += p[k];
+  }
+  std::array<std::array<double, 4>, 4> rules;  // by (lo == -1) * 2 + (hi == 2)
+  for (int lo : {-1, 0})
+    for (int hi : {1, 2}) rules[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))] = interval_rule(lo, hi, m);
+  const double scale = std::pow(h, m + 1);
+  for (std::size_t i = 0; i < intervals; ++i) {
+    const std::size_t k = window_.first + i;
+    const auto [lo, hi] = interval_nodes(k);
+    const auto& w = rules[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))];
+    double total = 0;
+    for (std::size_t j = 0; j < kPieceOffsets.size(); ++j)
+      if (w[j] != 0.0) total += w[j] * v[j][static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + kPieceOffsets[j])];
+    out[i] += scale * total;
+  }
+  return out;
 }
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t) {

@@ -15,6 +15,7 @@
 #include <span>
 #include <string>
 #include <variant>
+#include <utility>
 #include <vector>
 
 #include "ir/ir.hpp"
@@ -90,8 +91,25 @@ class Evaluator {
   const FitWindow& window() const { return window_; }
   const SampledRecord& record() const { return record_; }
 
+  // The model has held or linear inputs: every integral is taken interval by interval, within the
+  // segments between the inputs' changes of piece (runtime/operators/piecewise_inputs.hpp).
+  bool segmented() const { return segmented_; }
+  // True when a held or linear input occurs in `s`.
+  bool holds_piecewise_input(const ir::Sum& s) const;
+  // The stencil nodes lo..hi (lo in {-1, 0}, hi in {1, 2}) of the interval from sample k to k + 1:
+  // the samples around it that lie in the fit window and in its segment.
+  std::pair<int, int> interval_nodes(std::size_t k);
+  // `s` on piece record d (piecewise_inputs.hpp: each held or linear input replaced by the piece of
+  // the interval that starts d samples earlier), cut to the fit window; a Diagnostic for a term
+  // with an integral of such an input, whose pieces are not the integral's values.
+  std::variant<std::vector<double>, Diagnostic> evaluate_piece_in_window(const ir::Sum& s, int d, const std::string& what);
+
  private:
   using Values = std::vector<double>;
+  struct Pieces;  // the four piece records and their evaluators, made on first use
+  // Per interval [t_i, t_{i+1}] of the window: int (t_{i+1} - s)^m / m! s(t) dt, exact in held inputs.
+  std::variant<Values, Diagnostic> interval_integrals(const ir::Sum& s, int m);
+  Evaluator& piece(int d);
   std::variant<Values, Diagnostic> term(const ir::Term& t);
   std::variant<Values, Diagnostic> factor(const ir::Factor& f, const Span& where);
   std::variant<Values, Diagnostic> signal(const std::string& name, int order, const Span& where);
@@ -103,6 +121,9 @@ class Evaluator {
   FitWindow window_;
   std::map<std::pair<std::string, int>, Values> derivatives_;  // (signal, order) -> values
   std::map<std::string, Values> composite_;                    // integrals and der() by printed text
+  bool segmented_ = false;
+  std::vector<unsigned char> boundaries_;  // piece_boundaries(), made on first use
+  std::shared_ptr<Pieces> pieces_;
 };
 
 }  // namespace sidc

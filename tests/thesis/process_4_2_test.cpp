@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "compiler/pipeline.hpp"
 #include "process_record.hpp"
@@ -64,6 +65,21 @@ TEST(Section42, TheHeldInputStepsAtSamplesAndHoldsOneToFourIntervals) {
   }
   EXPECT_LE(run, 4u);
   EXPECT_GT(changes, 30u);  // 115 samples at 2.5 intervals per level on average: some 45 levels
+}
+
+// The held example's models: eq. 4-2.1 with the input declared held (the form chosen from the data)
+// and its twin declaring the same record's input smooth.
+TEST(Section42, HeldExampleModelsCompileWithTheirHolds) {
+  for (const auto& [file, hold] : {std::pair{"process_held.sid", ir::Signal::Hold::held},
+                                   std::pair{"process_held_as_smooth.sid", ir::Signal::Hold::smooth}}) {
+    const auto text = read(std::string(SIDC_SOURCE_DIR "/examples/thesis-4-2/") + file);
+    const auto compiled = compile(std::make_shared<const SourceFile>(file, text), {});
+    ASSERT_TRUE(compiled.ok()) << file << ": " << compiled.diagnostics.render_all();
+    const ir::Signal* x = compiled.integrated->signal("x");
+    ASSERT_NE(x, nullptr) << file;
+    EXPECT_EQ(x->hold, hold) << file;
+    EXPECT_TRUE(compiled.integrated->form_from_data) << file << ": the example names no form";
+  }
 }
 
 TEST(Section42, IntegratedForm424RecoversEquation425) {

@@ -6,7 +6,8 @@ step (`halving_check`): the largest difference at the samples, relative to each 
 deviation, is printed by `records.py` and stated in README.md. Coulomb friction (a sign() of the
 velocity) gets its own stepper, `rk4_sliding`, which locates each velocity reversal by bisection
 and decides there between slipping on and sticking (a Filippov solution), so no step straddles a
-change of the friction force. Pure Python, standard library only.
+change of the friction force. Inputs held between samples (`input x held`) get `rk4_held`, which
+keeps each input constant on each sample interval. Pure Python, standard library only.
 """
 
 import math
@@ -29,6 +30,24 @@ def rk4(f, x0, step, samples, substeps):
         t0 = (k - 1) * step
         for i in range(substeps):
             s = rk4_step(f, t0 + i * h, s, h)
+        out.append(list(s))
+    return out
+
+
+def rk4_held(f, x0, step, samples, substeps, inputs):
+    """As rk4, for inputs held between samples: f(t, s, u) with u = {name: value}, each input
+    constant on each sample interval at the value it has at the interval's start (inputs: name ->
+    one value per sample). The substeps stay inside the interval, so no RK4 step straddles a
+    change of level and none evaluates an input at an instant where it jumps."""
+    h = step / substeps
+    s = list(x0)
+    out = [list(s)]
+    for k in range(1, samples):
+        t0 = (k - 1) * step
+        u = {name: values[k - 1] for name, values in inputs.items()}
+        g = lambda t, state, u=u: f(t, state, u)
+        for i in range(substeps):
+            s = rk4_step(g, t0 + i * h, s, h)
         out.append(list(s))
     return out
 

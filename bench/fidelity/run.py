@@ -37,7 +37,8 @@ FOLLOWS_FIT_PERCENT = 90.0   # as kFollowsFitPercent in runtime/simulate/validat
 NOISE_LEVELS = [0.0, 0.001, 0.01, 0.05]
 QUICK_LEVELS = [0.001, 0.01]
 # Issue 13's targets for the default fit: largest relative error at 0.1% and 1% noise on the
-# smooth systems; 2% on the piecewise ones (guards, sign()).
+# smooth systems; 2% on the piecewise ones (guards, sign()). Counted over the eight systems the
+# issue named (System.issue13), so the count stays comparable as systems are added.
 TARGETS = {0.001: 0.0005, 0.01: 0.003}
 NON_SMOOTH_TARGET = 0.02
 
@@ -274,6 +275,8 @@ def tables(rows, configs, systems, levels):
         out.append("")
         met = cells = 0
         for s in systems:
+            if not s.issue13:  # counted over the eight systems the issue named
+                continue
             for lv, target in TARGETS.items():
                 errs = [r["max_rel_error"] for r in mine if r["system"] == s.name and r["noise"] == lv]
                 if errs:
@@ -368,12 +371,12 @@ def main():
         print(sensitivity(sidc, a.work, systems, a.timeout))
         return
 
-    # Noise-free records first (one solve per system, shared by every case).
-    for s in systems:
-        records.noise_free(s)
-
     jobs = [(c, s, lv, k) for c in configs for s in systems for lv in levels
             for k in range(1, (1 if lv == 0 else seeds) + 1)]
+    # Noise-free records first (one solve per system, shared by every case; per seed for a system
+    # with held inputs, whose steps are drawn per seed).
+    for _, s, _, k in jobs:
+        records.noise_free(s, k)
     print(f"fidelity: {len(jobs)} cases ({len(configs)} configuration(s) x {len(systems)} systems), "
           f"-j {a.jobs}, sidc = {sidc}", file=sys.stderr)
     rows = []

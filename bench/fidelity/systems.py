@@ -1,4 +1,4 @@
-"""The eight known-truth systems of the fidelity benchmark (issue 13, item 7).
+"""The known-truth systems of the fidelity benchmark (issue 13, item 7).
 
 Each system gives: its equations as a sidc model with the true terms (every parameter free, one
 term with a known coefficient, as sidc requires), the true parameter values, a candidate library
@@ -7,10 +7,15 @@ true candidates, the sampling (step, samples), the input signals (smooth multisi
 incommensurate frequencies, so the record excites the dynamics over a band), the initial state and
 the right-hand side that `integrate.py` solves. Sampling: tens of samples or more per period of
 the fastest input component and of the fastest mode, a few thousand samples.
+
+One system, `process_held`, has its input held between samples (`input x held`): the input is a
+sequence of levels, one per sample interval, drawn per seed (`held_input`), which the generator
+keeps constant on each interval (integrate.rk4_held).
 """
 
 import math
-from dataclasses import dataclass
+import random
+from dataclasses import dataclass, field
 
 
 def multisine(*components, offset=0.0):
@@ -22,7 +27,7 @@ def multisine(*components, offset=0.0):
 class System:
     name: str
     title: str
-    inputs: dict                 # input name -> function of t
+    inputs: dict                 # input name -> function of t (None for an input in held_input)
     outputs: list                # output names (recorded, noisy)
     states: list                 # state names as `sidc simulate --initial` takes them ("y", "y'")
     output_state: dict           # output name -> index in the state vector
@@ -38,6 +43,9 @@ class System:
     sliding: object = None       # (accel, friction, torque) for Coulomb friction
     notes: str = ""
     smooth: bool = True          # False: guards or sign() (issue 13's 2% target instead of 0.05% / 0.3%)
+    holds: dict = field(default_factory=dict)  # input name -> "held" / "linear" (`input x held`); absent: smooth
+    issue13: bool = True         # one of the eight systems issue 13's error targets are counted over
+    held_input: object = None    # f(seed) -> {input name: one value per sample, holding until the next}
 
 
 def _duffing():
@@ -158,6 +166,39 @@ def _process():
         notes="x = 100 + 30 sin 0.25t + 15 sin(0.07t + 1) + 10 sin(0.6t + 2); y1(0) = 0, y2(0) = 50")
 
 
+def held_steps(rng, samples, low, high, longest):
+    """One value per sample interval: a level drawn uniformly in [low, high], held for 1 to
+    `longest` intervals (equally likely), then a new level; as a test engineer applies steps."""
+    values = []
+    while len(values) < samples:
+        level = rng.uniform(low, high)
+        values.extend([level] * min(rng.randint(1, longest), samples - len(values)))
+    return values
+
+
+def _process_held():
+    # thesis eq. 4-2.5 as _process, with the input held between samples (thesis section 4-2: the
+    # plant's input was set and held, not swept); sampled as the thesis' record, every 0.75 min.
+    p = {"a1": -0.169520, "a2": -0.150604, "a3": -0.013276, "a4": 7.607216,
+         "a5": -0.166036, "a6": -0.170566, "a7": -0.001100, "a8": 8.578805}
+    samples = 115  # 0 to 85.5 min
+    return System(
+        name="process_held", title="two-output process (thesis eq. 4-2.5, input held between samples)",
+        inputs={"x": None}, outputs=["y1", "y2"], states=["y1", "y2"], output_state={"y1": 0, "y2": 1},
+        x0=[0.0, 50.0], step=0.75, samples=samples, substeps=15,
+        truth=p,
+        equations="y1' = a1*y1 + a2*y2 + a3*x + a4\ny2' = a5*y1 + a6*y2 + a7*x + a8",
+        library=("y1' = a1*y1 + a2*y2 + a3*x + a4 + p1*y1^2 + p2*y1*y2 + p3*y1*x + p4*x'\n"
+                 "y2' = a5*y1 + a6*y2 + a7*x + a8 + q1*y1^2 + q2*y1*y2 + q3*y1*x + q4*x'"),
+        library_truth={1: {"a1", "a2", "a3", "a4"}, 2: {"a5", "a6", "a7", "a8"}},
+        rhs=lambda t, s, u: [p["a1"] * s[0] + p["a2"] * s[1] + p["a3"] * u["x"] + p["a4"],
+                             p["a5"] * s[0] + p["a6"] * s[1] + p["a7"] * u["x"] + p["a8"]],
+        holds={"x": "held"}, issue13=False,
+        held_input=lambda seed: {"x": held_steps(random.Random(f"process_held/input/{seed}"), samples, 70.0, 130.0, 4)},
+        notes="x held between samples: levels uniform in [70, 130], each for 1 to 4 intervals of 0.75 min, "
+              "drawn by random.Random('process_held/input/SEED'); y1(0) = 0, y2(0) = 50")
+
+
 def _pendulum():
     J, c, f, k = 0.5, 0.1, 0.2, 2.0
     x = multisine((0.5, 1.7, 0.0), (0.4, 0.6, 0.4), (0.3, 3.1, 1.1))
@@ -178,5 +219,5 @@ def _pendulum():
 
 
 SYSTEMS = [_duffing(), _van_der_pol(), _lotka_volterra(), _third_order(), _piecewise(), _stiff(),
-           _process(), _pendulum()]
+           _process(), _pendulum(), _process_held()]
 BY_NAME = {s.name: s for s in SYSTEMS}

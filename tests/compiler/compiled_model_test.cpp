@@ -228,6 +228,42 @@ TEST(CompiledModelSchema, EveryGoldenModelValidates) {
   EXPECT_EQ(origins, (std::set<std::string>{"declared", "implicit", "integration_constant"}));
 }
 
+// Inputs declared held or linear (the cases of tests/golden/held/, which the corpus above leaves
+// out since some are in weak form, whose test functions it does not count): the file gives each
+// such input its hold, validates against the schema, and reads back with the same holds; a smooth
+// signal's entry has no `hold` at all.
+TEST(CompiledModelSchema, HeldInputsValidateAndReadBack) {
+  std::size_t models = 0, holds = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(SIDC_SOURCE_DIR) / "tests/golden/held")) {
+    if (entry.path().extension() != ".sid") continue;
+    const std::string name = entry.path().filename().string();
+    const auto model = compiled(Case{name, std::make_shared<const SourceFile>(name, read_text(entry.path())), {}});
+    ASSERT_TRUE(model.has_value()) << name;
+    const json j = as_read(*model);
+    const auto errors = testing::validate_against_schema(schema(), j);
+    EXPECT_TRUE(errors.empty()) << name << ":\n" << joined(errors);
+    std::string error;
+    const auto read = compiled_model_from_json(j, name + ".sidc.json", error);
+    ASSERT_TRUE(read.has_value()) << name << ": " << error;
+    for (const auto& s : j.at("signals")) {
+      const auto signal = s.at("name").get<std::string>();
+      const ir::Signal* written = model->normalized.signal(signal);
+      const ir::Signal* back = read->normalized.signal(signal);
+      ASSERT_TRUE(written && back) << name << ": " << signal;
+      EXPECT_EQ(back->hold, written->hold) << name << ": " << signal;
+      if (written->hold == ir::Signal::Hold::smooth) {
+        EXPECT_FALSE(s.contains("hold")) << name << ": " << signal;
+      } else {
+        EXPECT_EQ(s.value("hold", ""), ir::to_string(written->hold)) << name << ": " << signal;
+        ++holds;
+      }
+    }
+    ++models;
+  }
+  EXPECT_GE(models, 6u);
+  EXPECT_GE(holds, 7u);
+}
+
 json van_der_pol() {
   const fs::path path = fs::path(SIDC_SOURCE_DIR) / "tests/golden/integrated/thesis_2_2_8_van_der_pol_once.sid";
   Case c{"van der pol", std::make_shared<const SourceFile>("thesis_2_2_8_van_der_pol_once.sid", read_text(path)), {}};
@@ -261,6 +297,8 @@ TEST(CompiledModelSchema, RejectsDocumentsBrokenOnPurpose) {
       {"an infinite coefficient (written as null)", [](json& j) { j["equations"][0]["known"]["terms"][0]["coefficient"] = {{"real", nullptr}}; },
        "/coefficient: matches none"},
       {"signal without span", [](json& j) { j["signals"][0]["span"] = nullptr; }, "/signals/0/span: expected \"object\""},
+      {"unknown hold", [](json& j) { j["signals"][0]["hold"] = "step"; }, "/signals/0/hold: expected one of"},
+      {"hold written for a smooth signal", [](json& j) { j["signals"][0]["hold"] = "smooth"; }, "/signals/0/hold: expected one of"},
       {"bad hash", [](json& j) { j["source"]["hash"] = "395bc80f8c3f2a86"; }, "/source/hash"},
       {"integration constant without its equation", [](json& j) {
          for (auto& p : j["parameters"]) if (p["origin"] == "integration_constant") p["equation"] = -1;

@@ -1,11 +1,14 @@
 // Thesis section 4-2 on a synthetic record: the linear process of eq. 4-2.5, recovered through
 // the integrated form of eq. 4-2.4 (integration from the recorded initial values, no fitted
-// constants), with measurement noise. The thesis' own record is proprietary.
+// constants), with measurement noise. The thesis' own record is proprietary. Also the record of the
+// same process with its input held between samples (process_held_record.csv): the file and its input.
 #include <gtest/gtest.h>
 
-#include <cstdio>
+#include <cmath>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "compiler/pipeline.hpp"
 #include "process_record.hpp"
@@ -29,15 +32,54 @@ SampledRecord as_sampled(const thesis::ProcessRecord& r) {
 }
 
 TEST(Section42, TheExampleRecordIsTheGeneratorsOutput) {
-  const auto r = thesis::process_record();
-  std::string expected = "t,x,y1,y2\n";
-  char line[128];
-  for (std::size_t k = 0; k < r.t.size(); ++k) {
-    std::snprintf(line, sizeof line, "%.2f,%.6f,%.6f,%.6f\n", r.t[k], r.x[k], r.y1[k], r.y2[k]);
-    expected += line;
-  }
-  EXPECT_EQ(read(SIDC_SOURCE_DIR "/examples/thesis-4-2/process_record.csv"), expected)
+  EXPECT_EQ(read(SIDC_SOURCE_DIR "/examples/thesis-4-2/process_record.csv"), thesis::process_record_csv(thesis::process_record()))
       << "regenerate it: build/tests/thesis/write_process_record > examples/thesis-4-2/process_record.csv";
+}
+
+TEST(Section42, TheHeldExampleRecordIsTheGeneratorsOutput) {
+  EXPECT_EQ(read(SIDC_SOURCE_DIR "/examples/thesis-4-2/process_held_record.csv"),
+            thesis::process_record_csv(thesis::process_held_record()))
+      << "regenerate it: build/tests/thesis/write_process_record held > examples/thesis-4-2/process_held_record.csv";
+}
+
+// The held input is what process_record.hpp says: levels on a 0.1 grid in [70, 130], each held
+// for 1 to 4 sample intervals (the last run may be cut by the record's end), and every level
+// written exactly to the CSV's 6 decimals.
+TEST(Section42, TheHeldInputStepsAtSamplesAndHoldsOneToFourIntervals) {
+  const auto r = thesis::process_held_record();
+  ASSERT_EQ(r.t.size(), 115u);
+  EXPECT_DOUBLE_EQ(r.t.back(), 85.5);
+  std::size_t run = 1, changes = 0;
+  for (std::size_t k = 0; k < r.x.size(); ++k) {
+    EXPECT_GE(r.x[k], 70.0);
+    EXPECT_LE(r.x[k], 130.0);
+    EXPECT_EQ(r.x[k], std::round(r.x[k] * 10) / 10) << "sample " << k;
+    if (k == 0) continue;
+    if (r.x[k] == r.x[k - 1]) {
+      ++run;
+    } else {
+      EXPECT_LE(run, 4u) << "a level held for more than 4 intervals before sample " << k;
+      run = 1;
+      ++changes;
+    }
+  }
+  EXPECT_LE(run, 4u);
+  EXPECT_GT(changes, 30u);  // 115 samples at 2.5 intervals per level on average: some 45 levels
+}
+
+// The held example's models: eq. 4-2.1 with the input declared held (the form chosen from the data)
+// and its twin declaring the same record's input smooth.
+TEST(Section42, HeldExampleModelsCompileWithTheirHolds) {
+  for (const auto& [file, hold] : {std::pair{"process_held.sid", ir::Signal::Hold::held},
+                                   std::pair{"process_held_as_smooth.sid", ir::Signal::Hold::smooth}}) {
+    const auto text = read(std::string(SIDC_SOURCE_DIR "/examples/thesis-4-2/") + file);
+    const auto compiled = compile(std::make_shared<const SourceFile>(file, text), {});
+    ASSERT_TRUE(compiled.ok()) << file << ": " << compiled.diagnostics.render_all();
+    const ir::Signal* x = compiled.integrated->signal("x");
+    ASSERT_NE(x, nullptr) << file;
+    EXPECT_EQ(x->hold, hold) << file;
+    EXPECT_TRUE(compiled.integrated->form_from_data) << file << ": the example names no form";
+  }
 }
 
 TEST(Section42, IntegratedForm424RecoversEquation425) {

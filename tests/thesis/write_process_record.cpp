@@ -1,12 +1,18 @@
-// Writes the synthetic section 4-2 record (process_record.hpp) as CSV on standard output:
+// Writes a synthetic section 4-2 record (process_record.hpp) as CSV on standard output:
 //   build/tests/thesis/write_process_record > examples/thesis-4-2/process_record.csv
+//   build/tests/thesis/write_process_record held > examples/thesis-4-2/process_held_record.csv
 #include <cstdio>
+#include <cstring>
 
 #include "process_record.hpp"
 
-int main() {
-  const auto r = sidc::thesis::process_record();
-  std::printf("t,x,y1,y2\n");
-  for (std::size_t k = 0; k < r.t.size(); ++k) std::printf("%.2f,%.6f,%.6f,%.6f\n", r.t[k], r.x[k], r.y1[k], r.y2[k]);
+int main(int argc, char** argv) {
+  const bool held = argc == 2 && std::strcmp(argv[1], "held") == 0;
+  if (argc > 2 || (argc == 2 && !held)) {
+    std::fprintf(stderr, "usage: write_process_record [held]\n");
+    return 2;
+  }
+  const auto r = held ? sidc::thesis::process_held_record() : sidc::thesis::process_record();
+  std::fputs(sidc::thesis::process_record_csv(r).c_str(), stdout);
   return 0;
 }

@@ -383,10 +383,13 @@ Diagnostic hold_on_defined_input(const Span& where, std::string_view signal, std
 }
 
 Diagnostic derivative_of_held_input(const Span& where, std::string_view signal, std::string_view hold, std::string_view written) {
+  const bool held = hold == "held";
   return error("derivative-of-held-input", where,
-               fmt::format("`{}` is a derivative of the {} input `{}`, which has none between samples to estimate", written, hold, signal),
-               "write the model in integrated or weak form (`set form = weak`, `set integrate = 1`), where the derivative "
-               "is integrated away exactly, or declare the input `smooth` if it really moved smoothly");
+               fmt::format("`{}` is a derivative of the {} input `{}`, {}", written, hold, signal,
+                           held ? "which has none between samples, only a jump at each" : "whose slope jumps at every sample"),
+               "write the model in integrated or weak form (`set integrate = 1`, `set form = weak`), where a term linear in the "
+               "input's derivative is integrated away exactly (a product such as `x'*y` is not: rewrite it), or declare the "
+               "input `smooth` if it really moved smoothly");
 }
 
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes) {

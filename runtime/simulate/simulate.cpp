@@ -116,6 +116,9 @@ class System {
           return diag::signal_not_in_record(signal ? signal->span : Span{}, name, "the simulation's inputs");
         source.kind = Source::Kind::column;
         source.hold = signal ? signal->hold : ir::Signal::Hold::smooth;
+        if (order > 0 && source.hold != ir::Signal::Hold::smooth)  // a step or a kink has no derivative to estimate
+          return diag::simulate_derivative_of_held_input(signal->hold_span.known() ? signal->hold_span : signal->span, name,
+                                                         to_string(source.hold), prime(name, order));
         if (order == 0) {
           source.column = column->second;
         } else {  // a recorded input's derivative: the moving arc on the record, then interpolated

@@ -331,6 +331,24 @@ TEST(Simulate, LinearInputIsTheExactFirstOrderHold) {
   }
 }
 
+TEST(Simulate, DerivativeOfAHeldInputIsADiagnostic) {
+  for (const std::string hold : {"held", "linear"}) {
+    // The fit chooses this model's form, so it compiles; simulating its derivative form needs x'.
+    const ir::Model m = normalized("input x " + hold + "\noutput y\nparam a, b, c\ny' + a*y = b*x + c*x'\n");
+    SimulateOptions o;
+    o.parameters.assign(m.parameters.size(), 1.0);
+    o.initial["y"] = {0};
+    o.time = grid(0, 1, 0.1);
+    o.inputs["x"].assign(o.time.size(), 1.0);
+    auto r = simulate(m, form_of(m), o);
+    ASSERT_TRUE(std::holds_alternative<Diagnostic>(r)) << hold;
+    const Diagnostic& d = std::get<Diagnostic>(r);
+    EXPECT_EQ(d.code, "simulate-derivative-of-held-input");
+    EXPECT_NE(d.message.find("`x'`"), std::string::npos) << d.message;
+    EXPECT_NE(d.message.find(hold + " input `x`"), std::string::npos) << d.message;
+  }
+}
+
 TEST(Validate, ReproducesItsOwnRecordAndReportsDivergence) {
   const ir::Model m = normalized(kThesis);
   const ExplicitForm f = form_of(m);

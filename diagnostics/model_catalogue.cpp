@@ -452,6 +452,14 @@ Diagnostic simulate_estimated_derivative(const Span& where, std::string_view ter
                "write the derivative with primes (`y''`), or expand it so that it has a symbolic derivative");
 }
 
+Diagnostic simulate_derivative_of_held_input(const Span& where, std::string_view signal, std::string_view hold, std::string_view written) {
+  return error("simulate-derivative-of-held-input", where,
+               fmt::format("`{}` cannot be simulated: the {} input `{}` has no derivative between samples to estimate", written, hold, signal),
+               fmt::format("write the equation without it, moving the input into a new state (y' + a*y = c*{0}' is z' + a*z = -a*c*{0} "
+                           "with y = z + c*{0}), or declare the input `smooth` if it really moved smoothly",
+                           signal));
+}
+
 Diagnostic highest_derivative_nonlinear(const Span& where, std::string_view derivative, std::string_view how) {
   return error("highest-derivative-nonlinear", where,
                fmt::format("the equation cannot be solved for `{}`: it enters {}", derivative, how),

@@ -146,6 +146,7 @@ Diagnostic plot_parameter_not_fitted(const Span& where, std::string_view plot, s
 // ---- simulation (compiler/explicit_form_pass.cpp, runtime/simulate/simulate.cpp)
 Diagnostic simulate_integral(const Span& where, std::string_view term);
 Diagnostic simulate_estimated_derivative(const Span& where, std::string_view term);
+Diagnostic simulate_derivative_of_held_input(const Span& where, std::string_view signal, std::string_view hold, std::string_view written);
 Diagnostic highest_derivative_nonlinear(const Span& where, std::string_view derivative, std::string_view how);
 Diagnostic simulate_static_output(const Span& where, std::string_view output);
 Diagnostic simulate_equation_count(const Span& where, std::size_t equations, std::size_t outputs);

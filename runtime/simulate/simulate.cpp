@@ -115,6 +115,10 @@ class System {
         if (column == o.inputs.end())
           return diag::signal_not_in_record(signal ? signal->span : Span{}, name, "the simulation's inputs");
         source.kind = Source::Kind::column;
+        source.hold = signal ? signal->hold : ir::Signal::Hold::smooth;
+        if (order > 0 && source.hold != ir::Signal::Hold::smooth)  // a step or a kink has no derivative to estimate
+          return diag::simulate_derivative_of_held_input(signal->hold_span.known() ? signal->hold_span : signal->span, name,
+                                                         to_string(source.hold), prime(name, order));
         if (order == 0) {
           source.column = column->second;
         } else {  // a recorded input's derivative: the moving arc on the record, then interpolated
@@ -134,13 +138,23 @@ class System {
 
   std::size_t state_size() const { return form_->state_size(); }
 
+  // Whether an input holds or runs straight between samples: then no step may cross a sample
+  // instant, and the stepping loops say which sample interval they step in.
+  bool has_piecewise_inputs() const {
+    return std::any_of(sources_.begin(), sources_.end(),
+                       [](const Source& s) { return s.kind == Source::Kind::column && s.hold != ir::Signal::Hold::smooth; });
+  }
+  // Held and linear inputs take their value from [time[k], time[k+1]], even at its right end: the
+  // last stage of a step that ends at a sample sees the left limit, not the next sample's value.
+  void set_interval(std::size_t k) { interval_ = options_->time.size() < 2 ? 0 : std::min(k, options_->time.size() - 2); }
+
   void fill(double t, const double* state) {
     for (const auto& s : sources_) {
       double v = 0;
       switch (s.kind) {
         case Source::Kind::state: v = state[s.index]; break;
         case Source::Kind::definition: v = s.definition.evaluate({std::span<const double>(), t, options_->t0_for_tau}); break;
-        case Source::Kind::column: v = interpolate_cubic(options_->time, s.column, t); break;
+        case Source::Kind::column: v = recorded(s, t); break;
       }
       slots_[s.slot] = v;
     }
@@ -219,10 +233,25 @@ class System {
  private:
   struct Source {
     enum class Kind { state, definition, column } kind = Kind::state;
+    ir::Signal::Hold hold = ir::Signal::Hold::smooth;  // of a column
     std::size_t slot = 0, index = 0;
     PointSum definition;
     std::vector<double> column;
   };
+  // A recorded input at t, within the current interval for a held or linear one.
+  double recorded(const Source& s, double t) const {
+    const std::vector<double>& time = options_->time;
+    const std::size_t k = interval_;
+    switch (s.hold) {
+      case ir::Signal::Hold::smooth: return interpolate_cubic(time, s.column, t);
+      case ir::Signal::Hold::held: return s.column[k];
+      case ir::Signal::Hold::linear:
+        if (time.size() < 2) return s.column[0];
+        return s.column[k] + (s.column[k + 1] - s.column[k]) * (t - time[k]) / (time[k + 1] - time[k]);
+    }
+    return nan;
+  }
+
   const ExplicitForm* form_ = nullptr;
   const SimulateOptions* options_ = nullptr;
   PointLayout layout_;
@@ -234,6 +263,7 @@ class System {
   std::vector<double> slots_;
   std::optional<double> initial_det_;
   double last_det_ = 0;
+  std::size_t interval_ = 0;  // of options_->time, for held and linear inputs
 };
 
 using State = std::vector<double>;
@@ -339,6 +369,7 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
     std::vector<double> g0, g1;
     const bool locate = o.locate_switches && system.has_switches();
     for (std::size_t row = 1; row < n; ++row) {
+      system.set_interval(row - 1);
       const double h = (o.time[row] - o.time[row - 1]) / o.substeps;
       for (int sub = 0; sub < o.substeps; ++sub) {
         double t = o.time[row - 1] + sub * h;
@@ -399,8 +430,41 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
       return fmt::format("the simulation diverged: the adaptive stepper's step fell below 1e-12 of the time span at t = {:.6g} "
                          "(the solution is singular or extremely stiff there)", t);
     };
+    // A controlled stepper taken row by row, each step clamped to end at the next grid point.
+    auto step_rows = [&](auto stepper) {
+      double t = o.time[0], dt = first_step;
+      for (std::size_t row = 1; row < n; ++row) {
+        system.set_interval(row - 1);
+        // dopri5 reuses the last stage of a step as the first of the next: at a sample instant a
+        // held input jumps, so the next interval starts afresh.
+        if constexpr (requires { stepper.reset(); }) stepper.reset();
+        while (t < o.time[row]) {
+          if (t + dt > o.time[row]) dt = o.time[row] - t;
+          if (stepper.try_step(rhs, s, t, dt) == odeint::success) {
+            ++summary.steps;
+          } else if (dt < minimum_step(t)) {
+            const std::string why = too_small(t);
+            stop(system.trouble ? SimulationSummary::Status::singular : SimulationSummary::Status::diverged, why, t);
+            return;
+          }
+          if (system.trouble) {
+            stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
+            return;
+          }
+          if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
+            stop(SimulationSummary::Status::diverged, *bad, t);
+            return;
+          }
+        }
+        t = o.time[row];
+        record(row, s);
+      }
+    };
     try {
-      if (o.stepper == SimulateOptions::Stepper::dopri5) {
+      if (o.stepper == SimulateOptions::Stepper::dopri5 && system.has_piecewise_inputs()) {
+        // Dense output steps across grid points, and so across the jumps and kinks of held and linear inputs.
+        step_rows(odeint::make_controlled(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_dopri5<State>()));
+      } else if (o.stepper == SimulateOptions::Stepper::dopri5) {
         auto stepper = odeint::make_dense_output(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_dopri5<State>());
         stepper.initialize(s, o.time[0], first_step);
         for (std::size_t row = 1; row < n; ++row) {
@@ -428,33 +492,7 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
           record(row, s);
         }
       } else {
-        auto stepper = odeint::make_controlled(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_cash_karp54<State>());
-        double t = o.time[0], dt = first_step;
-        for (std::size_t row = 1; row < n; ++row) {
-          while (t < o.time[row]) {
-            if (t + dt > o.time[row]) dt = o.time[row] - t;
-            if (stepper.try_step(rhs, s, t, dt) == odeint::success) {
-              ++summary.steps;
-            } else if (dt < minimum_step(t)) {
-              const std::string why = too_small(t);
-              stop(system.trouble ? SimulationSummary::Status::singular : SimulationSummary::Status::diverged, why, t);
-              summary.right_hand_sides = system.evaluations;
-              return summary;
-            }
-            if (system.trouble) {
-              stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
-              summary.right_hand_sides = system.evaluations;
-              return summary;
-            }
-            if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
-              stop(SimulationSummary::Status::diverged, *bad, t);
-              summary.right_hand_sides = system.evaluations;
-              return summary;
-            }
-          }
-          t = o.time[row];
-          record(row, s);
-        }
+        step_rows(odeint::make_controlled(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_cash_karp54<State>()));
       }
     } catch (const std::exception& e) {  // Odeint gives up when no step size satisfies the tolerance
       const double t = system.evaluations ? system.trouble_time : o.time[0];

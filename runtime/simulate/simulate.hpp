@@ -11,8 +11,12 @@
 // Odeint's dopri5 / cash_karp with absolute and relative tolerances (the adaptive controller
 // shrinks its steps at a switch but does not locate it). Inputs bound to record columns are
 // interpolated between samples by the 4-point cubic through the neighbouring samples (RK4 needs
-// the input at half steps; linear interpolation would cap RK4's order at 2), inputs defined by
-// an expression of t are evaluated exactly. Nothing aborts: a state that is not finite or
+// the input at half steps; linear interpolation would cap RK4's order at 2), unless declared
+// `held` (the sample's value until the next sample) or `linear` (straight between samples): then
+// no step crosses a sample instant (dopri5 becomes a controlled stepper taken sample by sample
+// instead of dense output), a step ending at a sample sees the value its own interval has there,
+// and a derivative of such an input is a Diagnostic. Inputs defined by an expression of t are
+// evaluated exactly. Nothing aborts: a state that is not finite or
 // exceeds `divergence_bound`, or a coefficient matrix of the highest derivatives that becomes
 // singular or changes the sign of its determinant, stops the run with a status, the time and a
 // plain sentence; outputs after that time are NaN.

@@ -333,8 +333,13 @@ Diagnostic not_a_number(const Span& where, std::string_view what) {
 }
 
 Diagnostic input_definition_uses_signal(const Span& where, std::string_view input, std::string_view name) {
-  return error("input-definition", where, fmt::format("input `{}` is defined by an expression that uses `{}`", input, name),
-               "an input given as an expression may use only t, numbers and constants, e.g. `input x = 60*sin(4*pi*t)`");
+  std::string hint = "an input given as an expression may use only t, numbers and constants, e.g. `input x = 60*sin(4*pi*t)`";
+  // A guard of t is how a step would be written: say what does the job instead.
+  if (name == "[...]")
+    hint += fmt::format("; for a step, record `{0}` as a column of the data and declare it `input {0} held`, or write the step "
+                        "with sign(): `100 + 15*(1 + sign(t - 10))`",
+                        input);
+  return error("input-definition", where, fmt::format("input `{}` is defined by an expression that uses `{}`", input, name), hint);
 }
 
 Diagnostic binding_unknown_signal(const Span& where, std::string_view name, std::string_view nearest) {

@@ -147,22 +147,26 @@ def _stiff():
         notes="fast mode 1/50, slow mode about 2; x = sin 0.6t + 0.5 sin(5t + 1) + 0.3 sin(40t + 0.5)")
 
 
+# thesis eq. 4-2.5 (time in minutes): the process of `process` and `process_held`
+PROCESS_TRUTH = {"a1": -0.169520, "a2": -0.150604, "a3": -0.013276, "a4": 7.607216,
+                 "a5": -0.166036, "a6": -0.170566, "a7": -0.001100, "a8": 8.578805}
+PROCESS_MODEL = dict(
+    outputs=["y1", "y2"], states=["y1", "y2"], output_state={"y1": 0, "y2": 1}, x0=[0.0, 50.0],
+    truth=PROCESS_TRUTH,
+    equations="y1' = a1*y1 + a2*y2 + a3*x + a4\ny2' = a5*y1 + a6*y2 + a7*x + a8",
+    library=("y1' = a1*y1 + a2*y2 + a3*x + a4 + p1*y1^2 + p2*y1*y2 + p3*y1*x + p4*x'\n"
+             "y2' = a5*y1 + a6*y2 + a7*x + a8 + q1*y1^2 + q2*y1*y2 + q3*y1*x + q4*x'"),
+    library_truth={1: {"a1", "a2", "a3", "a4"}, 2: {"a5", "a6", "a7", "a8"}},
+    rhs=lambda t, s, u: [PROCESS_TRUTH["a1"] * s[0] + PROCESS_TRUTH["a2"] * s[1] + PROCESS_TRUTH["a3"] * u["x"] + PROCESS_TRUTH["a4"],
+                         PROCESS_TRUTH["a5"] * s[0] + PROCESS_TRUTH["a6"] * s[1] + PROCESS_TRUTH["a7"] * u["x"] + PROCESS_TRUTH["a8"]],
+)
+
+
 def _process():
-    # thesis eq. 4-2.5 (time in minutes)
-    p = {"a1": -0.169520, "a2": -0.150604, "a3": -0.013276, "a4": 7.607216,
-         "a5": -0.166036, "a6": -0.170566, "a7": -0.001100, "a8": 8.578805}
     x = multisine((30.0, 0.25, 0.0), (15.0, 0.07, 1.0), (10.0, 0.6, 2.0), offset=100.0)
     return System(
         name="process", title="two-output process (thesis eq. 4-2.5, smooth input)",
-        inputs={"x": x}, outputs=["y1", "y2"], states=["y1", "y2"], output_state={"y1": 0, "y2": 1},
-        x0=[0.0, 50.0], step=0.1, samples=3000, substeps=10,
-        truth=p,
-        equations="y1' = a1*y1 + a2*y2 + a3*x + a4\ny2' = a5*y1 + a6*y2 + a7*x + a8",
-        library=("y1' = a1*y1 + a2*y2 + a3*x + a4 + p1*y1^2 + p2*y1*y2 + p3*y1*x + p4*x'\n"
-                 "y2' = a5*y1 + a6*y2 + a7*x + a8 + q1*y1^2 + q2*y1*y2 + q3*y1*x + q4*x'"),
-        library_truth={1: {"a1", "a2", "a3", "a4"}, 2: {"a5", "a6", "a7", "a8"}},
-        rhs=lambda t, s, u: [p["a1"] * s[0] + p["a2"] * s[1] + p["a3"] * u["x"] + p["a4"],
-                             p["a5"] * s[0] + p["a6"] * s[1] + p["a7"] * u["x"] + p["a8"]],
+        inputs={"x": x}, step=0.1, samples=3000, substeps=10, **PROCESS_MODEL,
         notes="x = 100 + 30 sin 0.25t + 15 sin(0.07t + 1) + 10 sin(0.6t + 2); y1(0) = 0, y2(0) = 50")
 
 
@@ -179,20 +183,10 @@ def held_steps(rng, samples, low, high, longest):
 def _process_held():
     # thesis eq. 4-2.5 as _process, with the input held between samples (thesis section 4-2: the
     # plant's input was set and held, not swept); sampled as the thesis' record, every 0.75 min.
-    p = {"a1": -0.169520, "a2": -0.150604, "a3": -0.013276, "a4": 7.607216,
-         "a5": -0.166036, "a6": -0.170566, "a7": -0.001100, "a8": 8.578805}
     samples = 115  # 0 to 85.5 min
     return System(
         name="process_held", title="two-output process (thesis eq. 4-2.5, input held between samples)",
-        inputs={"x": None}, outputs=["y1", "y2"], states=["y1", "y2"], output_state={"y1": 0, "y2": 1},
-        x0=[0.0, 50.0], step=0.75, samples=samples, substeps=15,
-        truth=p,
-        equations="y1' = a1*y1 + a2*y2 + a3*x + a4\ny2' = a5*y1 + a6*y2 + a7*x + a8",
-        library=("y1' = a1*y1 + a2*y2 + a3*x + a4 + p1*y1^2 + p2*y1*y2 + p3*y1*x + p4*x'\n"
-                 "y2' = a5*y1 + a6*y2 + a7*x + a8 + q1*y1^2 + q2*y1*y2 + q3*y1*x + q4*x'"),
-        library_truth={1: {"a1", "a2", "a3", "a4"}, 2: {"a5", "a6", "a7", "a8"}},
-        rhs=lambda t, s, u: [p["a1"] * s[0] + p["a2"] * s[1] + p["a3"] * u["x"] + p["a4"],
-                             p["a5"] * s[0] + p["a6"] * s[1] + p["a7"] * u["x"] + p["a8"]],
+        inputs={"x": None}, step=0.75, samples=samples, substeps=15, **PROCESS_MODEL,
         holds={"x": "held"}, issue13=False,
         held_input=lambda seed: {"x": held_steps(random.Random(f"process_held/input/{seed}"), samples, 70.0, 130.0, 4)},
         notes="x held between samples: levels uniform in [70, 130], each for 1 to 4 intervals of 0.75 min, "

@@ -24,6 +24,7 @@
 #include "runtime/operators/evaluate.hpp"
 #include "runtime/operators/piecewise_inputs.hpp"
 #include "runtime/solve/fit.hpp"
+#include "support/fit_error.hpp"
 
 namespace sidc {
 namespace {
@@ -166,18 +167,7 @@ TEST(HeldInput, SegmentsKeepRulesOffTheKinks) {
 }
 
 double fitted_error(const std::string& text, const SampledRecord& record, double a, double b) {
-  const CompileResult c = compile(std::make_shared<const SourceFile>("m.sid", text), {});
-  EXPECT_TRUE(c.ok()) << c.diagnostics.render_all();
-  if (!c.ok()) return 1e9;
-  auto fitted = fit(*c.integrated, {record}, FitOptions{});
-  EXPECT_TRUE(std::holds_alternative<FitSummary>(fitted)) << std::get<Diagnostic>(fitted).message;
-  if (!std::holds_alternative<FitSummary>(fitted)) return 1e9;
-  double worst = 0;
-  for (const auto& p : std::get<FitSummary>(fitted).groups.at(0).summary.parameters) {
-    if (p.name == "a") worst = std::max(worst, std::abs(p.value / a - 1));
-    if (p.name == "b") worst = std::max(worst, std::abs(p.value / b - 1));
-  }
-  return worst;
+  return testing::largest_relative_error(text, record, {{"a", a}, {"b", b}});
 }
 
 TEST(HeldInput, FirstOrderSystemIsRecoveredInWeakAndIntegratedForms) {

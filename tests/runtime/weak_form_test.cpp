@@ -27,6 +27,7 @@
 #include "ir/print.hpp"
 #include "runtime/operators/test_functions.hpp"
 #include "runtime/solve/fit.hpp"
+#include "support/fit_error.hpp"
 
 namespace sidc {
 namespace {
@@ -142,18 +143,7 @@ SampledRecord simulate(const std::function<double(double, double, double)>& acce
   return r;
 }
 
-double largest_relative_error(const std::string& text, const SampledRecord& record, const std::map<std::string, double>& truth) {
-  const CompileResult c = compile(std::make_shared<const SourceFile>("m.sid", text), {});
-  EXPECT_TRUE(c.ok()) << c.diagnostics.render_all();
-  if (!c.ok()) return 1e9;
-  auto fitted = fit(*c.integrated, {record}, FitOptions{});
-  EXPECT_TRUE(std::holds_alternative<FitSummary>(fitted)) << std::get<Diagnostic>(fitted).message;
-  if (!std::holds_alternative<FitSummary>(fitted)) return 1e9;
-  double worst = 0;
-  for (const auto& p : std::get<FitSummary>(fitted).groups.at(0).summary.parameters)
-    worst = std::max(worst, std::abs(p.value / truth.at(p.name) - 1));
-  return worst;
-}
+using testing::largest_relative_error;
 
 const auto forcing = [](double t) { return 1.5 * std::sin(0.7 * t) + 0.8 * std::sin(1.9 * t + 0.3); };
 

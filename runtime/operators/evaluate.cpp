@@ -276,11 +276,14 @@ struct Evaluator::Pieces {
 
 Evaluator& Evaluator::piece(int d) {
   if (!pieces_) {
+    if (boundaries_.empty()) boundaries_ = piece_boundaries(record_, model_);
     pieces_ = std::make_shared<Pieces>();
     pieces_->evaluators.reserve(kPieceOffsets.size());
     for (std::size_t k = 0; k < kPieceOffsets.size(); ++k) {
       pieces_->records[k] = piece_record(record_, model_, kPieceOffsets[k]);
       pieces_->evaluators.emplace_back(pieces_->records[k], model_, options_, window_);
+      // The segments are the record's: a piece record's inputs are shifted, their steps with them.
+      pieces_->evaluators.back().boundaries_ = boundaries_;
     }
   }
   return pieces_->evaluators[static_cast<std::size_t>(d - kPieceOffsets.front())];

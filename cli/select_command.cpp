@@ -132,6 +132,14 @@ int run_select(const SelectArguments& a) {
   }
 
   auto result = select_operations(model, records, o);
+  std::string form_note = weak_by_default ? "form: weak (the model sets none; `set form` chooses another)\n" : "";
+  if (auto* d = std::get_if<Diagnostic>(&result); d && weak_by_default && d->code == "weak-form-too-short") {
+    // A record too short for the weak form's subdomains (the 115 samples of thesis section 4-2):
+    // the integrated form needs no margin, and is what sidc fit's form choice falls back to there.
+    form_note = fmt::format("form: integrated (the model sets none, and the weak form cannot be built: {})\n", d->message);
+    compiled->integrated = rewritten_in_form(compiled->normalized, "integrated");
+    result = select_operations(model, records, o);
+  }
   if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
   const SelectSummary& summary = std::get<SelectSummary>(result);
   if (!summary.ok()) return fail(render(cli_diag::selection_failed(summary.message)), exit_code::user_error);
@@ -141,8 +149,7 @@ int run_select(const SelectArguments& a) {
       std::cerr << fmt::format("{}: warning: `{}` is nearly a polynomial in t of degree {} over the window (before integration, a + b t holds {:.4f}% of it): a drift absorber{}\n",
                                a.model, d.column, d.degree, 100 * d.share,
                                d.set_aside ? "; set aside before the search (give --keep-drift or --require to search it)" : "");
-  std::cout << fmt::format("sidc select: model `{}` ({}), size rule {}\n{}\n", model.name, a.model, to_string(o.rule),
-                           weak_by_default ? "form: weak (the model sets none; `set form` chooses another)\n" : "")
+  std::cout << fmt::format("sidc select: model `{}` ({}), size rule {}\n{}\n", model.name, a.model, to_string(o.rule), form_note)
             << summary.report();
   if (!a.out.empty()) {
     auto written = write_select_file(a.out, summary, a.model, o);

@@ -322,6 +322,25 @@ TEST(SelectBinary, SameSeedSameAnswer) {
   EXPECT_EQ(a["groups"][0]["bootstrap"], b["groups"][0]["bootstrap"]);
 }
 
+// A model naming no form is selected in the weak form; on a record too short for the weak form's
+// subdomains (200 samples: this library needs more), select falls back to the integrated form,
+// says so, and still finds the true operations of the noise-free record.
+TEST(SelectBinary, ShortRecordFallsBackFromTheWeakToTheIntegratedForm) {
+  std::ifstream in(clean_record());
+  const fs::path short_record = work() / "short.csv";
+  std::ofstream out(short_record);
+  std::string line;
+  for (int row = 0; row <= 200 && std::getline(in, line); ++row) out << line << "\n";
+  out.close();
+  const auto j = select_json("candidates_no_form.sid", short_record, "--require m");
+  ASSERT_FALSE(j.is_discarded());
+  EXPECT_NE(last_select.out.find("form: integrated (the model sets none, and the weak form cannot be built"), std::string::npos)
+      << last_select.out;
+  EXPECT_EQ(chosen(j), kTrueIntegrated);
+  select_json("candidates_no_form.sid", clean_record(), "--require m");
+  EXPECT_NE(last_select.out.find("form: weak"), std::string::npos) << last_select.out;
+}
+
 TEST(SelectBinary, BadOptionsAreUsageErrors) {
   const std::string model = shell_quoted(kModels / "candidates_integrated.sid") + " --data " + shell_quoted(clean_record());
   struct Case {

@@ -119,6 +119,17 @@ TEST(HeldInput, IntegralsAreExactSumsOverTheSteps) {
   EXPECT_GT(worst, 0.02);
 }
 
+TEST(HeldInput, IntegralOfAProductWithAnIntegralOfItIsNamedNotGuessed) {
+  const SampledRecord r = stepped_record(30, 0.1);
+  const ir::Model held = model_with(ir::Signal::Hold::held);
+  FitWindow w{0, r.time.size() - 1};
+  Evaluator e(r, held, EvaluationOptions{}, w);
+  auto v = e.evaluate(integral(ir::multiply(signal("y"), integral(signal("x")))));  // y*int(x) varies within an interval
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(v));
+  EXPECT_EQ(std::get<Diagnostic>(v).code, "held-input-integral-unsupported");
+  EXPECT_NE(std::get<Diagnostic>(v).message.find("`x`"), std::string::npos) << std::get<Diagnostic>(v).message;
+}
+
 TEST(LinearInput, IntegralIsTheTrapezoidOfItsSamples) {
   const SampledRecord r = stepped_record(30, 0.1);
   const auto v = evaluated(r, model_with(ir::Signal::Hold::linear), integral(signal("x")));

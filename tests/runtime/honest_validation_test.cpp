@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "compiler/explicit_form_pass.hpp"
+#include "support/simulation.hpp"
 #include "compiler/pipeline.hpp"
 #include "runtime/simulate/initial_state.hpp"
 #include "runtime/simulate/simulate.hpp"
@@ -35,18 +36,8 @@ CompileResult compiled(const std::string& text) {
   return r;
 }
 
-ExplicitForm form_of(const ir::Model& m) {
-  auto f = explicit_form(m);
-  EXPECT_TRUE(std::holds_alternative<ExplicitForm>(f)) << render(std::get<Diagnostic>(f));
-  return std::get<ExplicitForm>(f);
-}
-
-std::vector<double> grid(double t0, double t1, double step) {
-  std::vector<double> t;
-  const auto n = static_cast<std::size_t>(std::llround((t1 - t0) / step));
-  for (std::size_t i = 0; i <= n; ++i) t.push_back(t0 + static_cast<double>(i) * step);
-  return t;
-}
+using testing::form_of;
+using testing::grid;
 
 const char* kOscillator = "input x = 0.5*cos(1.3*t)\noutput y\nparam a, b, c\na*y'' + b*y' + c*y = x\n";
 const std::vector<double> kTrue = {1, 0.02, 4};

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "compiler/explicit_form_pass.hpp"
+#include "support/simulation.hpp"
 #include "compiler/pipeline.hpp"
 #include "runtime/operators/point_evaluator.hpp"
 #include "runtime/simulate/simulate.hpp"
@@ -21,18 +22,8 @@ ir::Model normalized(const std::string& text) {
   return *r.normalized;
 }
 
-ExplicitForm form_of(const ir::Model& m) {
-  auto f = explicit_form(m);
-  EXPECT_TRUE(std::holds_alternative<ExplicitForm>(f)) << render(std::get<Diagnostic>(f));
-  return std::get<ExplicitForm>(f);
-}
-
-std::vector<double> grid(double t0, double t1, double step) {
-  std::vector<double> t;
-  const auto n = static_cast<std::size_t>(std::llround((t1 - t0) / step));
-  for (std::size_t i = 0; i <= n; ++i) t.push_back(t0 + static_cast<double>(i) * step);
-  return t;
-}
+using testing::form_of;
+using testing::grid;
 
 SimulationSummary run(const ir::Model& m, const ExplicitForm& f, SimulateOptions o) {
   auto r = simulate(m, f, o);

@@ -289,27 +289,31 @@ Evaluator& Evaluator::piece(int d) {
   return pieces_->evaluators[static_cast<std::size_t>(d - kPieceOffsets.front())];
 }
 
-bool Evaluator::holds_piecewise_input(const ir::Sum& s) const { return sidc::holds_piecewise_input(model_, s); }
-
-namespace {
-
-// The held or linear input a term holds, for messages.
-std::string piecewise_input_name(const ir::Model& model, const ir::Term& t) {
-  std::string name;
-  ir::any_factor(ir::canonical(std::vector<ir::Term>{t}), [&](const ir::Factor& f) {
-    if (f.kind == FactorKind::signal && piecewise_input(model, f.name)) name = f.name;
-    return !name.empty();
-  });
-  return name;
-}
-
-}  // namespace
-
-std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate_piece_in_window(const ir::Sum& s, int d, const std::string& what) {
-  for (const auto& t : s.terms)
+std::variant<Evaluator::Stencil, Diagnostic> Evaluator::stencil_values(const ir::Sum& s, const std::string* what) {
+  std::vector<ir::Term> smooth, held;  // evaluated once; on the piece records
+  for (const auto& t : s.terms) {
     if (has_piecewise_integral(model_, t))
-      return diag::held_input_integral_unsupported(t.span, print(ir::canonical(std::vector<ir::Term>{t})), piecewise_input_name(model_, t));
-  return piece(d).evaluate_in_window(s, what);
+      return diag::held_input_integral_unsupported(t.span, print(ir::canonical(std::vector<ir::Term>{t})), piecewise_input_of(model_, t)->name);
+    (piecewise_input_of(model_, t) ? held : smooth).push_back(t);
+  }
+  auto values_of = [&](Evaluator& e, const ir::Sum& part) { return what ? e.evaluate_in_window(part, *what) : e.evaluate(part); };
+  Values common(what ? window_.size() : record_.time.size(), 0.0);
+  if (!smooth.empty()) {
+    auto values = values_of(*this, ir::canonical(std::move(smooth)));
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    common = std::get<Values>(std::move(values));
+  }
+  const ir::Sum held_part = ir::canonical(std::move(held));
+  Stencil v;
+  for (std::size_t j = 0; j < kPieceOffsets.size(); ++j) {
+    v[j] = common;
+    if (held_part.empty()) continue;
+    auto values = values_of(piece(kPieceOffsets[j]), held_part);
+    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+    const Values& p = std::get<Values>(values);
+    for (std::size_t k = 0; k < p.size(); ++k) v[j][k] += p[k];
+  }
+  return v;
 }
 
 std::pair<int, int> Evaluator::interval_nodes(std::size_t k) {
@@ -325,16 +329,16 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::interval_integrals(cons
   double factorial = 1;
   for (int j = 2; j <= m + 1; ++j) factorial *= j;
   Values out(intervals, 0.0);
-  std::vector<ir::Term> smooth, held;  // evaluated once; on the piece records
+  std::vector<ir::Term> local;  // the rest: integrated on their pieces
   for (const auto& t : s.terms) {
     if (!has_piecewise_integral(model_, t)) {
-      (sidc::holds_piecewise_input(model_, ir::canonical(std::vector<ir::Term>{t})) ? held : smooth).push_back(t);
+      local.push_back(t);
       continue;
     }
     // c * F with F = int(g): int (t_{i+1} - s)^m / m! F = h^(m+1)/(m+1)! F(t_i) + int (t_{i+1} - s)^(m+1)/(m+1)! g.
     const bool integral_alone = t.factors.size() == 1 && t.factors[0].second == 1 && t.factors[0].first.kind == FactorKind::integral;
     if (!integral_alone)
-      return diag::held_input_integral_unsupported(t.span, print(ir::canonical(std::vector<ir::Term>{t})), piecewise_input_name(model_, t));
+      return diag::held_input_integral_unsupported(t.span, print(ir::canonical(std::vector<ir::Term>{t})), piecewise_input_of(model_, t)->name);
     const ir::Factor& integral = t.factors[0].first;
     auto values = factor(integral, t.span);
     if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
@@ -345,32 +349,15 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::interval_integrals(cons
     const double c = t.coefficient.value(), scale = std::pow(h, m + 1) / factorial;
     for (std::size_t i = 0; i < intervals; ++i) out[i] += c * (scale * F[window_.first + i] + g[i]);
   }
-  if ((smooth.empty() && held.empty()) || intervals == 0) return out;
-  // v[j][k]: the integrand at sample k as interval k - d sees it (d = kPieceOffsets[j]).
-  std::array<Values, kPieceOffsets.size()> v;
-  Values common(record_.time.size(), 0.0);
-  if (!smooth.empty()) {
-    auto values = evaluate(ir::canonical(std::move(smooth)));
-    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    common = std::get<Values>(std::move(values));
-  }
-  const ir::Sum held_part = ir::canonical(std::move(held));
-  for (std::size_t j = 0; j < kPieceOffsets.size(); ++j) {
-    v[j] = common;
-    if (held_part.empty()) continue;
-    auto values = piece(kPieceOffsets[j]).evaluate(held_part);
-    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    const Values& p = std::get<Values>(values);
-    for (std::size_t k = 0; k < p.size(); ++k) v[j][k] += p[k];
-  }
-  std::array<std::array<double, 4>, 4> rules;  // by (lo == -1) * 2 + (hi == 2)
-  for (int lo : {-1, 0})
-    for (int hi : {1, 2}) rules[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))] = interval_rule(lo, hi, m);
+  if (local.empty() || intervals == 0) return out;
+  auto stencil = stencil_values(ir::canonical(std::move(local)));
+  if (auto* d = std::get_if<Diagnostic>(&stencil)) return *d;
+  const Stencil& v = std::get<Stencil>(stencil);  // v[j][k]: sample k as interval k - kPieceOffsets[j] sees it
+  const IntervalRules rules(m);
   const double scale = std::pow(h, m + 1);
   for (std::size_t i = 0; i < intervals; ++i) {
     const std::size_t k = window_.first + i;
-    const auto [lo, hi] = interval_nodes(k);
-    const auto& w = rules[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))];
+    const auto& w = rules(interval_nodes(k));
     double total = 0;
     for (std::size_t j = 0; j < kPieceOffsets.size(); ++j)
       if (w[j] != 0.0) total += w[j] * v[j][static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + kPieceOffsets[j])];

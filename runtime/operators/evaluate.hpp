@@ -10,6 +10,7 @@
 // infinite inside the fit window is reported with the source span of the operation that made it.
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <span>
@@ -94,15 +95,16 @@ class Evaluator {
   // The model has held or linear inputs: every integral is taken interval by interval, within the
   // segments between the inputs' changes of piece (runtime/operators/piecewise_inputs.hpp).
   bool segmented() const { return segmented_; }
-  // True when a held or linear input occurs in `s`.
-  bool holds_piecewise_input(const ir::Sum& s) const;
   // The stencil nodes lo..hi (lo in {-1, 0}, hi in {1, 2}) of the interval from sample k to k + 1:
   // the samples around it that lie in the fit window and in its segment.
   std::pair<int, int> interval_nodes(std::size_t k);
-  // `s` on piece record d (piecewise_inputs.hpp: each held or linear input replaced by the piece of
-  // the interval that starts d samples earlier), cut to the fit window; a Diagnostic for a term
-  // with an integral of such an input, whose pieces are not the integral's values.
-  std::variant<std::vector<double>, Diagnostic> evaluate_piece_in_window(const ir::Sum& s, int d, const std::string& what);
+  // `s` at each sample as the interval d samples earlier sees it, one array per d of kPieceOffsets
+  // (piecewise_inputs.hpp): the terms holding a held or linear input on piece record d, the others
+  // once. With `what`, cut to the fit window, a value that is not finite reported as
+  // evaluate_in_window() does; without, over the whole record. A Diagnostic for a term with an
+  // integral of such an input, whose pieces are not the integral's values.
+  using Stencil = std::array<std::vector<double>, 4>;
+  std::variant<Stencil, Diagnostic> stencil_values(const ir::Sum& s, const std::string* what = nullptr);
 
  private:
   using Values = std::vector<double>;

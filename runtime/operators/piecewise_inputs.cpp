@@ -16,6 +16,14 @@ bool holds_piecewise_input(const ir::Model& model, const ir::Sum& s) {
   return ir::any_factor(s, [&](const ir::Factor& f) { return f.kind == ir::FactorKind::signal && piecewise_input(model, f.name); });
 }
 
+const ir::Signal* piecewise_input_of(const ir::Model& model, const ir::Term& t) {
+  const ir::Signal* found = nullptr;
+  ir::any_factor(ir::canonical(std::vector<ir::Term>{t}), [&](const ir::Factor& f) {
+    return f.kind == ir::FactorKind::signal && (found = piecewise_input(model, f.name)) != nullptr;
+  });
+  return found;
+}
+
 bool has_piecewise_integral(const ir::Model& model, const ir::Term& t) {
   const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
   return ir::any_factor(single, [&](const ir::Factor& f) { return f.kind == ir::FactorKind::integral && holds_piecewise_input(model, *f.argument); });
@@ -77,6 +85,11 @@ std::array<double, 4> interval_rule(int lo, int hi, int m) {
     w[static_cast<std::size_t>(d + 1)] = total;
   }
   return w;
+}
+
+IntervalRules::IntervalRules(int m) {
+  for (int lo : {-1, 0})
+    for (int hi : {1, 2}) rules_[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))] = interval_rule(lo, hi, m);
 }
 
 }  // namespace sidc

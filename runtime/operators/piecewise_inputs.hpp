@@ -21,6 +21,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 
 #include "ir/ir.hpp"
 #include "runtime/records/sampled_record.hpp"
@@ -35,6 +36,9 @@ const ir::Signal* piecewise_input(const ir::Model& model, const std::string& nam
 
 // True when a held or linear input occurs anywhere in `s`, inside integrals, functions and guards too.
 bool holds_piecewise_input(const ir::Model& model, const ir::Sum& s);
+
+// The first held or linear input `t` holds (anywhere in it), or nullptr.
+const ir::Signal* piecewise_input_of(const ir::Model& model, const ir::Term& t);
 
 // True when `t` has an integral, at any depth, whose integrand holds a held or linear input: such
 // a factor is continuous but kinked at every sample, and only the integrand's pieces, not the
@@ -58,5 +62,17 @@ bool has_piecewise_inputs(const ir::Model& model);
 // Lagrange polynomial of node d, so that int_{t_i}^{t_{i+1}} (t_{i+1} - s)^m / m! G(s) ds =
 // h^(m+1) sum_d w[d+1] G(t_{i+d}), exact for cubic G. For m = 0 on four nodes: (-1, 13, 13, -1)/24.
 std::array<double, 4> interval_rule(int lo, int hi, int m);
+
+// The four rules of weight m an interval can have, by its nodes (lo, hi) (Evaluator::interval_nodes).
+class IntervalRules {
+ public:
+  explicit IntervalRules(int m);
+  const std::array<double, 4>& operator()(std::pair<int, int> nodes) const {
+    return rules_[static_cast<std::size_t>((nodes.first == -1) * 2 + (nodes.second == 2))];
+  }
+
+ private:
+  std::array<std::array<double, 4>, 4> rules_;
+};
 
 }  // namespace sidc

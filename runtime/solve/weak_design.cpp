@@ -68,15 +68,6 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
   }
   std::fill(out.begin(), out.end(), 0.0);
   const std::size_t m = grid_.half_width;
-  auto add = [&](const std::vector<double>& g, const std::vector<double>& w) {
-    for (std::size_t j = 0; j < grid_.centres.size() && j < out.size(); ++j) {
-      const double* x = g.data() + (grid_.centres[j] - m);
-      double s = 0;
-      for (std::size_t i = 0; i < w.size(); ++i)
-        if (w[i] != 0.0) s += w[i] * x[i];
-      out[j] += s;
-    }
-  };
   for (const auto& [k, terms] : parts) {
     if (weights_.size() <= static_cast<std::size_t>(k)) weights_.resize(static_cast<std::size_t>(k) + 1);
     auto& w = weights_[static_cast<std::size_t>(k)];
@@ -84,38 +75,28 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
     if (!evaluator_.segmented()) {
       auto values = evaluator_.evaluate_in_window(ir::canonical(terms), what);
       if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-      add(std::get<std::vector<double>>(values), w);
+      const std::vector<double>& g = std::get<std::vector<double>>(values);
+      for (std::size_t j = 0; j < grid_.centres.size() && j < out.size(); ++j) {
+        const double* x = g.data() + (grid_.centres[j] - m);
+        double s = 0;
+        for (std::size_t i = 0; i < w.size(); ++i) s += w[i] * x[i];
+        out[j] += s;
+      }
       continue;
     }
     // Held or linear inputs: int phi^(k) g interval by interval within the inputs' segments, g read
     // on its pieces (runtime/operators/piecewise_inputs.hpp); phi^(k) vanishes outside the support.
-    std::vector<ir::Term> smooth, held;
-    for (const auto& t : terms) (evaluator_.holds_piecewise_input(ir::canonical(std::vector<ir::Term>{t})) ? held : smooth).push_back(t);
-    std::array<std::vector<double>, kPieceOffsets.size()> g;  // g[o][a]: window sample a as interval a - d sees it
-    std::vector<double> common(evaluator_.window().size(), 0.0);
-    if (!smooth.empty()) {
-      auto values = evaluator_.evaluate_in_window(ir::canonical(smooth), what);
-      if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-      common = std::get<std::vector<double>>(std::move(values));
-    }
-    for (std::size_t o = 0; o < kPieceOffsets.size(); ++o) {
-      g[o] = common;
-      if (held.empty()) continue;
-      auto values = evaluator_.evaluate_piece_in_window(ir::canonical(held), kPieceOffsets[o], what);
-      if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-      const auto& p = std::get<std::vector<double>>(values);
-      for (std::size_t a = 0; a < p.size(); ++a) g[o][a] += p[a];
-    }
-    std::array<std::array<double, 4>, 4> rules;  // by (lo == -1) * 2 + (hi == 2)
-    for (int lo : {-1, 0})
-      for (int hi : {1, 2}) rules[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))] = interval_rule(lo, hi, 0);
+    auto stencil = evaluator_.stencil_values(ir::canonical(terms), &what);
+    if (auto* d = std::get_if<Diagnostic>(&stencil)) return *d;
+    const Evaluator::Stencil& g = std::get<Evaluator::Stencil>(stencil);  // g[o][a]: window sample a as interval a - d sees it
+    const IntervalRules rules(0);
     const std::size_t first = evaluator_.window().first;
     for (std::size_t j = 0; j < grid_.centres.size() && j < out.size(); ++j) {
       const std::size_t start = grid_.centres[j] - m;  // window sample of the support's first node
       double total = 0;
       for (std::size_t i = 0; i + 1 < w.size(); ++i) {  // the support's 2m intervals
         const auto [lo, hi] = evaluator_.interval_nodes(first + start + i);
-        const auto& rule = rules[static_cast<std::size_t>((lo == -1) * 2 + (hi == 2))];
+        const auto& rule = rules({lo, hi});
         for (int d = lo; d <= hi; ++d) {
           const auto r = static_cast<std::ptrdiff_t>(i) + d;  // node of the support (test function sample)
           if (r < 0 || r >= static_cast<std::ptrdiff_t>(w.size()) || w[static_cast<std::size_t>(r)] == 0.0) continue;

@@ -41,4 +41,15 @@ bool is_static(const ir::Model& model) {
   return true;
 }
 
+const ir::Signal* piecewise_input(const ir::Model& model, const std::string& name) {
+  const ir::Signal* s = model.signal(name);
+  return s && s->kind == ir::Signal::Kind::input && !s->definition && s->hold != ir::Signal::Hold::smooth ? s : nullptr;
+}
+
+const ir::Signal* first_piecewise_input(const ir::Model& model, const ir::Sum& s) {
+  const ir::Signal* found = nullptr;
+  ir::any_factor(s, [&](const ir::Factor& f) { return f.kind == ir::FactorKind::signal && (found = piecewise_input(model, f.name)) != nullptr; });
+  return found;
+}
+
 }  // namespace sidc

@@ -1,8 +1,10 @@
 // Questions asked of a compiled model by more than one layer: what estimating its derivatives
-// costs, and whether it is dynamic at all. The compiler's integrate_pass chooses the number of
+// costs, whether it is dynamic at all, and which of its inputs are held between samples. The compiler's integrate_pass chooses the number of
 // integrations with them; the runtime sizes derivative margins and decides whether a record needs
 // a time column. They live here, beside the IR, so that neither reaches into the other.
 #pragma once
+
+#include <string>
 
 #include "ir/ir.hpp"
 
@@ -17,5 +19,13 @@ bool is_dynamic(const ir::Sum& s);
 // True when no equation has a derivative, an integral or the time in it: a static regression such
 // as NIST's `y = b0 + b1*x`, whose records need no time column.
 bool is_static(const ir::Model& model);
+
+// The input `name` when it is recorded and held or linear (`input x held`); nullptr for outputs,
+// smooth inputs and inputs given as an expression. compiler/hold_check_pass.cpp rejects their
+// derivatives; runtime/operators/piecewise_inputs.hpp integrates them exactly.
+const ir::Signal* piecewise_input(const ir::Model& model, const std::string& name);
+
+// The first held or linear input occurring in `s`, inside integrals, functions and guards too; nullptr if none.
+const ir::Signal* first_piecewise_input(const ir::Model& model, const ir::Sum& s);
 
 }  // namespace sidc

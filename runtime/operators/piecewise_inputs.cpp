@@ -7,26 +7,13 @@
 
 namespace sidc {
 
-const ir::Signal* piecewise_input(const ir::Model& model, const std::string& name) {
-  const ir::Signal* s = model.signal(name);
-  return s && s->kind == ir::Signal::Kind::input && !s->definition && s->hold != ir::Signal::Hold::smooth ? s : nullptr;
-}
-
-bool holds_piecewise_input(const ir::Model& model, const ir::Sum& s) {
-  return ir::any_factor(s, [&](const ir::Factor& f) { return f.kind == ir::FactorKind::signal && piecewise_input(model, f.name); });
-}
-
 const ir::Signal* piecewise_input_of(const ir::Model& model, const ir::Term& t) {
-  const ir::Signal* found = nullptr;
-  ir::any_factor(ir::canonical(std::vector<ir::Term>{t}), [&](const ir::Factor& f) {
-    return f.kind == ir::FactorKind::signal && (found = piecewise_input(model, f.name)) != nullptr;
-  });
-  return found;
+  return first_piecewise_input(model, ir::canonical(std::vector<ir::Term>{t}));
 }
 
 bool has_piecewise_integral(const ir::Model& model, const ir::Term& t) {
-  const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
-  return ir::any_factor(single, [&](const ir::Factor& f) { return f.kind == ir::FactorKind::integral && holds_piecewise_input(model, *f.argument); });
+  return ir::any_factor(ir::canonical(std::vector<ir::Term>{t}),
+                        [&](const ir::Factor& f) { return f.kind == ir::FactorKind::integral && first_piecewise_input(model, *f.argument); });
 }
 
 bool has_piecewise_inputs(const ir::Model& model) {

@@ -24,18 +24,13 @@
 #include <utility>
 
 #include "ir/ir.hpp"
+#include "ir/queries.hpp"  // piecewise_input(), first_piecewise_input()
 #include "runtime/records/sampled_record.hpp"
 
 namespace sidc {
 
 // The stencil offsets d of the samples i + d around interval i.
 inline constexpr std::array<int, 4> kPieceOffsets{-1, 0, 1, 2};
-
-// The input `name` when it is held or linear; nullptr for outputs, smooth and defined inputs.
-const ir::Signal* piecewise_input(const ir::Model& model, const std::string& name);
-
-// True when a held or linear input occurs anywhere in `s`, inside integrals, functions and guards too.
-bool holds_piecewise_input(const ir::Model& model, const ir::Sum& s);
 
 // The first held or linear input `t` holds (anywhere in it), or nullptr.
 const ir::Signal* piecewise_input_of(const ir::Model& model, const ir::Term& t);

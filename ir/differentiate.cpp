@@ -11,29 +11,50 @@ Sum function_of(const std::string& name, const Sum& argument) {
   return ir::factor(Factor{FactorKind::function, name, 0, {}, {}, ir::share(argument), {}});
 }
 
-// d/dt of a single factor (power 1), or nullopt.
-std::optional<Sum> derivative_of(const Factor& f) {
+// What a derivative is taken with respect to: time (no signal), or one signal derivative y^(m)
+// held as an independent variable, as in the Jacobian of an ODE's right-hand side.
+struct Variable {
+  const std::string* signal = nullptr;
+  int order = 0;
+};
+
+std::optional<Sum> derivative_of(const Sum& s, const Variable& v);
+std::optional<Sum> derivative_of(const ir::Term& t, const Variable& v);
+
+// d/dt or the partial derivative of a single factor (power 1), or nullopt.
+std::optional<Sum> derivative_of(const Factor& f, const Variable& v) {
+  const bool in_time = v.signal == nullptr;
   switch (f.kind) {
     case FactorKind::parameter:
     case FactorKind::window_start:
     case FactorKind::initial_value: return Sum{};
     case FactorKind::signal: {
+      if (!in_time) return f.name == *v.signal && f.order == v.order ? ir::number(1) : Sum{};
       Factor next = f;
       ++next.order;
       return ir::factor(next);
     }
     case FactorKind::time:
-    case FactorKind::elapsed: return ir::number(1);
-    case FactorKind::integral: return *f.argument;  // d/dt int(u) = u
+    case FactorKind::elapsed: return in_time ? ir::number(1) : Sum{};
+    case FactorKind::integral:  // d/dt int(u) = u; a partial derivative of an integral has no value at a point
+      if (!in_time) return std::nullopt;
+      return *f.argument;
     case FactorKind::test_function:  // phi_j^(k)' = phi_j^(k+1), known exactly
+      if (!in_time) return Sum{};
+      [[fallthrough]];
     case FactorKind::derivative: {
+      if (!in_time) return std::nullopt;
       Factor next = f;
       ++next.order;
       return ir::factor(next);
     }
-    case FactorKind::guard: return std::nullopt;
+    // A guard is constant between its switches: its partial derivative is 0 there, which is what
+    // the Jacobian of a right-hand side needs; in time it jumps, and d/dt has no Sum.
+    case FactorKind::guard:
+      if (!in_time) return Sum{};
+      return std::nullopt;
     case FactorKind::power: {  // (u^e)' = e u^(e-1) u'
-      auto du = differentiate(*f.argument);
+      auto du = derivative_of(*f.argument, v);
       if (!du) return std::nullopt;
       auto lowered = raise(*f.argument, f.exponent - Number(1));
       if (!lowered) return std::nullopt;
@@ -41,7 +62,7 @@ std::optional<Sum> derivative_of(const Factor& f) {
     }
     case FactorKind::function: {
       const Sum& u = *f.argument;
-      auto du = differentiate(u);
+      auto du = derivative_of(u, v);
       if (!du) return std::nullopt;
       Sum outer;
       if (f.name == "sin") outer = function_of("cos", u);
@@ -53,6 +74,7 @@ std::optional<Sum> derivative_of(const Factor& f) {
         const Sum th = function_of("tanh", u);
         outer = ir::subtract(ir::number(1), ir::multiply(th, th));
       } else if (f.name == "abs") outer = function_of("sign", u);
+      else if (f.name == "sign" && !in_time) return Sum{};  // constant between its jumps, like a guard
       else return std::nullopt;  // sign() jumps
       return ir::multiply(outer, *du);
     }
@@ -91,11 +113,13 @@ std::optional<Sum> raise(const Sum& u, const Number& e, std::size_t max_terms) {
   return ir::factor(Factor{FactorKind::power, "", 0, {}, e, ir::share(u), {}});
 }
 
-std::optional<Sum> differentiate(const ir::Term& t) {
+namespace {
+
+std::optional<Sum> derivative_of(const ir::Term& t, const Variable& v) {
   std::vector<ir::Term> terms;
   for (std::size_t i = 0; i < t.factors.size(); ++i) {
     const auto& [f, power] = t.factors[i];
-    auto df = derivative_of(f);
+    auto df = derivative_of(f, v);
     if (!df) return std::nullopt;
     // d(f^k) = k f^(k-1) f', times the other factors.
     ir::Term rest{t.coefficient * Number(power), {}, t.span};
@@ -107,18 +131,32 @@ std::optional<Sum> differentiate(const ir::Term& t) {
   return ir::canonical(std::move(terms));
 }
 
+std::optional<Sum> derivative_of(const Sum& s, const Variable& v) {
+  std::vector<ir::Term> terms;
+  for (const auto& t : s.terms) {
+    auto dt = derivative_of(t, v);
+    if (!dt) return std::nullopt;
+    terms.insert(terms.end(), dt->terms.begin(), dt->terms.end());
+  }
+  return ir::canonical(std::move(terms));
+}
+
+}  // namespace
+
+std::optional<Sum> differentiate(const ir::Term& t) { return derivative_of(t, Variable{}); }
+
 std::optional<Sum> differentiate(const Sum& s, int times) {
   Sum current = s;
   for (int k = 0; k < times; ++k) {
-    std::vector<ir::Term> terms;
-    for (const auto& t : current.terms) {
-      auto dt = differentiate(t);
-      if (!dt) return std::nullopt;
-      terms.insert(terms.end(), dt->terms.begin(), dt->terms.end());
-    }
-    current = ir::canonical(std::move(terms));
+    auto next = derivative_of(current, Variable{});
+    if (!next) return std::nullopt;
+    current = std::move(*next);
   }
   return current;
+}
+
+std::optional<Sum> partial_derivative(const Sum& s, const std::string& signal, int order) {
+  return derivative_of(s, Variable{&signal, order});
 }
 
 }  // namespace sidc

@@ -1,5 +1,5 @@
-// Symbolic time derivatives of IR sums: the product rule over factors and the chain rule through
-// the language's functions.
+// Symbolic time derivatives of IR sums, and partial derivatives with respect to one signal
+// derivative: the product rule over factors and the chain rule through the language's functions.
 //
 // Used by lower_pass (to expand `der(y^3, 1)` into `3*y^2*y'`, eq. 2-2.7 read backwards) and by
 // integrate_pass (an antiderivative is accepted only when its derivative reproduces the terms it
@@ -15,6 +15,12 @@ namespace sidc {
 
 std::optional<ir::Sum> differentiate(const ir::Sum& s, int times = 1);
 std::optional<ir::Sum> differentiate(const ir::Term& t);
+
+// The partial derivative of `s` with respect to the signal derivative `signal`^(order), every
+// other signal derivative, t and the parameters held constant: the Jacobian of a right-hand side,
+// as output-error refinement's sensitivity equations need it (runtime/refine/). Guards and sign()
+// count as constant (0 between their switches); int() and der() have none (nullopt).
+std::optional<ir::Sum> partial_derivative(const ir::Sum& s, const std::string& signal, int order);
 
 // 1/u as a sum: inverted powers for a single term, else the factor (u)^-1.
 ir::Sum reciprocal(const ir::Sum& u);

@@ -21,12 +21,23 @@ constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 std::string prime(const std::string& name, int order) { return name + std::string(static_cast<std::size_t>(order), '\''); }
 
-// A ParametricSum with the parameter values substituted: sum_k weight_k * sum_k(point).
+// A ParametricSum with the parameter values substituted: sum_k weight_k * sum_k(point). Each
+// part's value is kept for the sensitivity equations, where d/d a_k of the sum is part k itself.
 struct Weighted {
-  std::vector<std::pair<double, PointSum>> parts;
+  struct Part {
+    double weight = 1;
+    int parameter = -1;  // the parameter whose value `weight` is; -1 for the parameter-free part
+    PointSum sum;
+  };
+  std::vector<Part> parts;
+  mutable std::vector<double> values;  // of each part at the last evaluation
   double operator()(const PointInstant& at) const {
+    values.resize(parts.size());
     double v = 0;
-    for (const auto& [w, s] : parts) v += w * s.evaluate(at);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      values[i] = parts[i].sum.evaluate(at);
+      v += parts[i].weight * values[i];
+    }
     return v;
   }
 };
@@ -62,17 +73,42 @@ class System {
     form_ = &form;
     compile_options_.initial_value = o.initial_value;
     options_ = &o;
+    sensitivities_ = o.sensitivities;
+    // A part whose parameter is 0 adds nothing to the equations, but its sensitivity is the part itself.
     auto weighted = [&](const ParametricSum& p, Weighted& out) -> std::optional<Diagnostic> {
-      auto add = [&](double w, const ir::Sum& s) -> std::optional<Diagnostic> {
-        if (s.empty() || w == 0) return std::nullopt;
+      auto add = [&](double w, int parameter, const ir::Sum& s) -> std::optional<Diagnostic> {
+        if (s.empty() || (w == 0 && !sensitivities_)) return std::nullopt;
         auto c = compile_point_sum(s, layout_, compile_options_);
         if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
-        out.parts.emplace_back(w, std::get<PointSum>(std::move(c)));
+        out.parts.push_back({w, parameter, std::get<PointSum>(std::move(c))});
         return std::nullopt;
       };
-      if (auto d = add(1.0, p.constant)) return d;
+      if (auto d = add(1.0, -1, p.constant)) return d;
       for (const auto& t : p.terms)
-        if (auto d = add(o.parameters[static_cast<std::size_t>(t.parameter)], t.operation)) return d;
+        if (auto d = add(o.parameters[static_cast<std::size_t>(t.parameter)], t.parameter, t.operation)) return d;
+      return std::nullopt;
+    };
+    // d/dx_m of a ParametricSum for each state component x_m: the Jacobian the variational
+    // equations need, derived symbolically (ir/differentiate.hpp), weighted like the sum itself.
+    auto partials = [&](const ParametricSum& p, std::vector<Weighted>& out) -> std::optional<Diagnostic> {
+      out.assign(form.state_size(), {});
+      std::size_t m = 0;
+      for (const auto& output : form.outputs)
+        for (int order = 0; order < output.order; ++order, ++m) {
+          auto add = [&](double w, const ir::Sum& s, Span span) -> std::optional<Diagnostic> {
+            if (s.empty() || w == 0) return std::nullopt;
+            auto d = partial_derivative(s, output.name, order);
+            if (!d) return diag::simulate_estimated_derivative(span, prime(output.name, order));
+            if (d->empty()) return std::nullopt;
+            auto c = compile_point_sum(*d, layout_, compile_options_);
+            if (auto* e = std::get_if<Diagnostic>(&c)) return *e;
+            out[m].parts.push_back({w, -1, std::get<PointSum>(std::move(c))});
+            return std::nullopt;
+          };
+          if (auto d = add(1.0, p.constant, output.span)) return d;
+          for (const auto& t : p.terms)
+            if (auto d = add(o.parameters[static_cast<std::size_t>(t.parameter)], t.operation, output.span)) return d;
+        }
       return std::nullopt;
     };
     const std::size_t k = form.outputs.size();
@@ -82,6 +118,16 @@ class System {
       for (std::size_t j = 0; j < k; ++j)
         if (auto d = weighted(form.coefficient[i][j], coefficient_[i][j])) return d;
       if (auto d = weighted(form.rest[i], rest_[i])) return d;
+    }
+    if (sensitivities_) {
+      parameters_ = o.parameters.size();
+      coefficient_partial_.assign(k, std::vector<std::vector<Weighted>>(k));
+      rest_partial_.assign(k, {});
+      for (std::size_t i = 0; i < k; ++i) {
+        for (std::size_t j = 0; j < k; ++j)
+          if (auto d = partials(form.coefficient[i][j], coefficient_partial_[i][j])) return d;
+        if (auto d = partials(form.rest[i], rest_partial_[i])) return d;
+      }
     }
     for (const auto& g : form.switching_functions) {
       auto c = compile_point_sum(g, layout_, compile_options_);
@@ -137,6 +183,10 @@ class System {
   }
 
   std::size_t state_size() const { return form_->state_size(); }
+  // The integrated vector: the state, then (with sensitivities) d state / d q column by column for
+  // q = the parameters, then the initial state's components.
+  std::size_t sensitivity_columns() const { return sensitivities_ ? parameters_ + state_size() : 0; }
+  std::size_t vector_size() const { return state_size() * (1 + sensitivity_columns()); }
 
   // Whether an input holds or runs straight between samples: then no step may cross a sample
   // instant, and the stepping loops say which sample interval they step in.
@@ -177,19 +227,24 @@ class System {
       const double a = coefficient_[0][0](at), r = rest_[0](at);
       det = a;
       out[state_offset_[0] + static_cast<std::size_t>(form_->outputs[0].order) - 1] = -r / a;
+      if (sensitivities_) {
+        a_.setConstant(1, 1, a);
+        z_.setConstant(1, -r / a);
+      }
     } else {
-      Eigen::MatrixXd a(k, k);
+      a_.resize(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
       Eigen::VectorXd r(k);
       for (std::size_t i = 0; i < k; ++i) {
-        for (std::size_t j = 0; j < k; ++j) a(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = coefficient_[i][j](at);
+        for (std::size_t j = 0; j < k; ++j) a_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = coefficient_[i][j](at);
         r(static_cast<Eigen::Index>(i)) = rest_[i](at);
       }
-      Eigen::PartialPivLU<Eigen::MatrixXd> lu(a);
+      Eigen::PartialPivLU<Eigen::MatrixXd> lu(a_);
       det = lu.determinant();
-      const Eigen::VectorXd z = lu.solve(-r);
+      z_ = lu.solve(-r);
       for (std::size_t j = 0; j < k; ++j)
-        out[state_offset_[j] + static_cast<std::size_t>(form_->outputs[j].order) - 1] = z(static_cast<Eigen::Index>(j));
+        out[state_offset_[j] + static_cast<std::size_t>(form_->outputs[j].order) - 1] = z_(static_cast<Eigen::Index>(j));
     }
+    if (sensitivities_ && std::isfinite(det) && det != 0) sensitivity_derivative(at, state, out);
     // eq. 4-1.1 divided by m: a coefficient that vanishes or changes sign on the way makes the
     // highest derivative infinite or the equation a different one; stop there.
     if (!initial_det_) initial_det_ = det;
@@ -231,6 +286,42 @@ class System {
   double trouble_time = 0;
 
  private:
+  // The variational equations (the state's sensitivities S = d x / d q, column by column after the
+  // state): dS/dt = J_x S + [J_p 0]. For the chain rows (y^(m))' = y^(m+1) this is S's next row;
+  // for the highest derivatives z, from A z + r = 0: A dz/dq = -(d(A z + r)/dx S + d(A z + r)/dp).
+  // Integrated by the same RK4 steps as the state, S is the exact derivative of the discrete run.
+  void sensitivity_derivative(const PointInstant& at, const double* state, double* out) {
+    const std::size_t k = form_->outputs.size(), n = state_size(), q_count = sensitivity_columns();
+    const auto K = static_cast<Eigen::Index>(k), N = static_cast<Eigen::Index>(n), Q = static_cast<Eigen::Index>(q_count);
+    // G = d(A z + r)/dx (k x n); C = G S + [H 0], H = d(A z + r)/dp (k x P).
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(K, N);
+    c_.setZero(K, Q);
+    for (std::size_t i = 0; i < k; ++i) {
+      const auto I = static_cast<Eigen::Index>(i);
+      auto add_parameters = [&](const Weighted& w, double factor) {
+        for (std::size_t p = 0; p < w.parts.size(); ++p)
+          if (w.parts[p].parameter >= 0) c_(I, w.parts[p].parameter) += factor * w.values[p];
+      };
+      for (std::size_t m = 0; m < n; ++m) g(I, static_cast<Eigen::Index>(m)) += rest_partial_[i][m](at);
+      add_parameters(rest_[i], 1.0);
+      for (std::size_t j = 0; j < k; ++j) {
+        const double zj = z_(static_cast<Eigen::Index>(j));
+        for (std::size_t m = 0; m < n; ++m) g(I, static_cast<Eigen::Index>(m)) += zj * coefficient_partial_[i][j][m](at);
+        add_parameters(coefficient_[i][j], zj);
+      }
+    }
+    const Eigen::Map<const Eigen::MatrixXd> s(state + n, N, Q);
+    c_.noalias() += g * s;
+    const Eigen::MatrixXd dz = k == 1 ? Eigen::MatrixXd(-c_ / a_(0, 0)) : Eigen::MatrixXd(a_.partialPivLu().solve(-c_));
+    Eigen::Map<Eigen::MatrixXd> ds(out + n, N, Q);
+    for (std::size_t j = 0; j < k; ++j) {
+      const std::size_t base = state_offset_[j];
+      const int order = form_->outputs[j].order;
+      for (int m = 0; m + 1 < order; ++m) ds.row(static_cast<Eigen::Index>(base) + m) = s.row(static_cast<Eigen::Index>(base) + m + 1);
+      ds.row(static_cast<Eigen::Index>(base) + order - 1) = dz.row(static_cast<Eigen::Index>(j));
+    }
+  }
+
   struct Source {
     enum class Kind { state, definition, column } kind = Kind::state;
     ir::Signal::Hold hold = ir::Signal::Hold::smooth;  // of a column
@@ -258,6 +349,12 @@ class System {
   PointCompileOptions compile_options_;
   std::vector<std::vector<Weighted>> coefficient_;
   std::vector<Weighted> rest_;
+  bool sensitivities_ = false;
+  std::size_t parameters_ = 0;
+  std::vector<std::vector<std::vector<Weighted>>> coefficient_partial_;  // [i][j][state component]
+  std::vector<std::vector<Weighted>> rest_partial_;                      // [i][state component]
+  Eigen::MatrixXd a_, c_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
+  Eigen::VectorXd z_;      // the highest derivatives
   std::vector<PointSum> switching_;
   std::vector<Source> sources_;
   std::vector<double> slots_;
@@ -342,15 +439,25 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
     summary.output_names.push_back(out.name);
     summary.outputs.emplace_back(n, nan);
   }
-  State s(system.state_size(), 0.0);
+  State s(system.vector_size(), 0.0);
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {
     auto it = o.initial.find(form.outputs[j].name);
     for (int m = 0; m < form.outputs[j].order; ++m)
       s[system.state_offset_[j] + static_cast<std::size_t>(m)] =
           it != o.initial.end() && static_cast<std::size_t>(m) < it->second.size() ? it->second[static_cast<std::size_t>(m)] : 0.0;
   }
+  const std::size_t n_state = system.state_size(), columns = system.sensitivity_columns();
+  summary.sensitivity_columns = columns;
+  if (columns) {
+    // d x(t0) / d x0 = I: the initial state's columns follow the parameters'.
+    for (std::size_t m = 0; m < n_state; ++m) s[n_state + (o.parameters.size() + m) * n_state + m] = 1;
+    summary.sensitivity.assign(form.outputs.size(), std::vector<double>(n * columns, nan));
+  }
   auto record = [&](std::size_t row, const State& x) {
-    for (std::size_t j = 0; j < form.outputs.size(); ++j) summary.outputs[j][row] = x[system.state_offset_[j]];
+    for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+      summary.outputs[j][row] = x[system.state_offset_[j]];
+      for (std::size_t q = 0; q < columns; ++q) summary.sensitivity[j][row * columns + q] = x[n_state + q * n_state + system.state_offset_[j]];
+    }
   };
   auto stop = [&](SimulationSummary::Status status, std::string message, double t) {
     summary.status = status;

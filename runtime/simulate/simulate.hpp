@@ -55,6 +55,13 @@ struct SimulateOptions {
   // unset, or nullopt from it: the model cannot be simulated (a Diagnostic at the term).
   std::function<std::optional<double>(const ir::Factor&)> initial_value;
 
+  // Also integrate the sensitivities d y / d q of every output to every parameter of the normalized
+  // model and every initial-state component (the variational equations, with Jacobians derived
+  // symbolically by ir/differentiate.hpp): the exact Jacobian output-error refinement needs
+  // (runtime/refine/refine.hpp). Under RK4 they are the exact derivatives of the discrete run, except
+  // across a guard switch, whose jump in the sensitivities is not added.
+  bool sensitivities = false;
+
   bool is_valid(std::string* why) const;
 };
 
@@ -69,6 +76,11 @@ struct SimulationSummary {
   std::vector<double> time;
   std::vector<std::string> output_names;
   std::vector<std::vector<double>> outputs;  // per output, on `time`; NaN after stopped_at
+  // With SimulateOptions::sensitivities: per output, row-major [row * sensitivity_columns + q], d y / d q
+  // for q = the parameters (in the normalized model's order), then the initial state (per output
+  // y, y', ..., in the order of the explicit form's outputs).
+  std::vector<std::vector<double>> sensitivity;
+  std::size_t sensitivity_columns = 0;
   bool completed() const { return status == Status::completed; }
   std::string brief_report() const;
 };

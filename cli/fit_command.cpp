@@ -21,9 +21,12 @@
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
+#include "ir/settings.hpp"
+#include "runtime/refine/refine.hpp"
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/fit.hpp"
+#include "runtime/solve/fitted_values.hpp"
 #include "runtime/solve/model_comparison.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
@@ -42,6 +45,7 @@ struct FitArguments {
   std::string initial_state = "estimate";  // the validation's start: estimated, or read from the record
   std::string plots;                  // --plots DIR
   std::string report;                 // --report FILE.html
+  bool refine = false;                // --refine: output-error refinement after the linear fit
 };
 
 // The compiled model to fit when none is named: the most recently compiled *.sidc.json in the
@@ -111,6 +115,28 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   if (!is_static(model)) std::cout << "\n";
   std::cout << summary.full_report(model);
 
+  // Output-error refinement (issue 15): from the linear estimate, the parameters whose solved
+  // equations reproduce the fitted records best. A failure keeps the linear estimate and says so.
+  std::optional<RefineSummary> refinement;
+  if ((a.refine || refine_by_simulation(compiled->normalized.settings)) && summary.is_solution_usable()) {
+    if (auto* d = std::get_if<Diagnostic>(&*compiled->explicit_form)) {
+      refinement.emplace();
+      refinement->message = "the equations cannot be solved for their highest derivatives (" + d->message + "); the equation-error estimate is kept";
+    } else {
+      RefineOptions ro;
+      ro.evaluation = options->evaluation;
+      ro.max_samples = a.validate_samples;
+      std::vector<const SampledRecord*> fitted;
+      for (const auto& r : records) fitted.push_back(&r);
+      auto refined = refine(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form),
+                            fitted_parameter_values(compiled->normalized, summary, 0.0), fitted, ro);
+      if (auto* problem = std::get_if<Diagnostic>(&refined)) return fail(render(*problem), exit_code::user_error);
+      refinement = std::get<RefineSummary>(std::move(refined));
+    }
+    std::cout << "\n" << refinement->report();
+    if (!refinement->improved()) std::cerr << "sidc fit: warning: not refined: " << refinement->message << "\n";
+  }
+
   std::optional<FitValidation> validation;
   if (!a.no_validate) {
     // The fitted records, then those given only to be compared with (not copied: records can be long).
@@ -124,7 +150,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (const auto& r : records) checked.push_back(&r);
     for (const auto& r : extra) checked.push_back(&r);
     validation = validate_fit(compiled->normalized, *compiled->explicit_form, summary, checked, records.size(), options->evaluation,
-                              a.validate_samples, a.initial_state == "record" ? InitialState::record : InitialState::estimate);
+                              a.validate_samples, a.initial_state == "record" ? InitialState::record : InitialState::estimate,
+                              refinement && refinement->improved() ? &refinement->values : nullptr);
     if (validation->failed_record)
       return fail(render(cli_diag::cannot_validate(validation->failed_path, *validation->failed_record)), exit_code::user_error);
     std::cout << validation_report(*validation);
@@ -134,7 +161,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
 
   if (!out_dir.empty()) {
     auto written = write_fit_files(out_dir, {*compiled, compiled_path, summary, *options, records, validation, residuals,
-                                             choice ? &*choice : nullptr});
+                                             choice ? &*choice : nullptr, refinement ? &*refinement : nullptr});
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
     if (paths.size() == 3) std::cerr << "wrote " << paths[0] << ", " << paths[1] << " and " << paths[2] << "\n";
@@ -195,6 +222,9 @@ void add_fit_command(CLI::App& app, int& exit_status) {
       ->check(CLI::IsMember({"estimate", "record"}));
   cmd->add_option("--plots", a->plots, "Directory for the pictures (SVG and PNG, drawn by gnuplot): outputs, errors, functions, residual tests");
   cmd->add_option("--report", a->report, "Write a one-page HTML report with the fit's tables and pictures to this file");
+  cmd->add_flag("--refine", a->refine,
+                "Refine the parameters by the output error: Levenberg-Marquardt over the parameters and each record's initial state, "
+                "minimising the difference between the records and the solved equations (as `set refine = simulation`)");
   auto* no_validate = cmd->add_flag("--no-validate", a->no_validate, "Do not solve the fitted equations and compare them with the records (thesis section 2-4)");
   cmd->add_option("--validate", a->validate, "Also compare the solved fitted equations with this record, not used in fitting (repeatable)")
       ->allow_extra_args(false)

@@ -95,6 +95,12 @@ std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& mod
       for (const auto& p : g.value("parameters", nlohmann::json::array()))
         if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
           if (auto f = assign(p["name"].get<std::string>(), p["estimate"].get<double>(), true)) return *f;
+    // A fit refined by the output error (sidc fit --refine): its refined values are the fit's answer.
+    const auto& refinement = j.contains("refinement") ? j["refinement"] : nlohmann::json();
+    if (refinement.is_object() && refinement.value("status", "") != "failed" && refinement.contains("parameters") && refinement["parameters"].is_array())
+      for (const auto& p : refinement["parameters"])
+        if (p.contains("name") && p["name"].is_string() && p.contains("refined") && p["refined"].is_number())
+          if (auto f = assign(p["name"].get<std::string>(), p["refined"].get<double>(), true)) return *f;
   }
   for (const auto& text : a.params) {
     auto parsed = name_value(text, "--param", "a1=0.5");
@@ -267,7 +273,7 @@ void add_simulate_command(CLI::App& app, int& exit_status) {
   auto a = std::make_shared<SimulateArguments>();
   CLI::App* cmd = app.add_subcommand("simulate", "Solve a model's equations with given parameter values (thesis section 2-4)");
   cmd->add_option("model", a->model, "Model file (.sid) or compiled model (.sidc.json)")->required();
-  cmd->add_option("--params", a->params_file, "Parameter values from a fit (DIR/fit.json of `sidc fit --out DIR`)");
+  cmd->add_option("--params", a->params_file, "Parameter values from a fit (DIR/fit.json of `sidc fit --out DIR`; the refined ones when it was refined)");
   cmd->add_option("--param", a->params, "Parameter values, NAME=VALUE ... (overrides --params)");
   cmd->add_option("--data", a->data, "Record giving the time grid, the inputs and the initial state (default: the model's data statement)");
   cmd->add_option("--every", a->every, "Keep every K-th sample of the record")->check(CLI::PositiveNumber);

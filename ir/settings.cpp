@@ -26,7 +26,7 @@ std::optional<int> whole_number(const std::string& text) {
 
 const std::vector<std::string>& setting_keys() {
   static const std::vector<std::string> keys{"integrate", "form", "constants", "derivative", "second_derivative", "edges",
-                                             "integration", "smooth_before_integration", "from", "to", "every", "step", "weights"};
+                                             "integration", "smooth_before_integration", "from", "to", "every", "step", "weights", "refine"};
   return keys;
 }
 
@@ -78,12 +78,20 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
   } else if (key == "weights") {
     static const std::regex column(R"("[^"]+"|[A-Za-z_][A-Za-z0-9_]*)");
     if (!std::regex_match(value, column)) r.expected = "the name of a record column holding the weight of each row (eq. 2-1.6), e.g. `w` or `\"weight\"`";
+  } else if (key == "refine") {
+    if (value != "none" && value != "simulation")
+      r.expected = "`simulation` (refine the fit by the error of the solved equations, `sidc fit --refine`) or `none`";
   } else if (key == "step") {
     if (!positive_number(value)) r.expected = "a positive sampling step, e.g. `0.01`";
   } else {
     r.unknown_key = true;
   }
   return r;
+}
+
+bool refine_by_simulation(const ir::Settings& settings) {
+  auto it = settings.values.find("refine");
+  return it != settings.values.end() && it->second.text == "simulation";
 }
 
 void request_form(ir::IntegrationRequest& request, const std::string& form) {

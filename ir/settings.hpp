@@ -48,6 +48,10 @@ struct EvaluationSettings {
 // and span are left as they are. Shared by `set form`, `sidc compile --form` and sidc fit's choice.
 void request_form(ir::IntegrationRequest& request, const std::string& form);
 
+// `set refine = simulation`: sidc fit refines the equation-error estimate by the output error
+// (runtime/refine/refine.hpp), as `--refine` asks.
+bool refine_by_simulation(const ir::Settings& settings);
+
 // Typed settings from checked raw values (check_setting has accepted every one).
 EvaluationSettings evaluation_settings(const ir::Settings& settings);
 // Reads `savgol(7, 3)` or `savgol(auto)`; nullopt if the text is not of that form with a valid

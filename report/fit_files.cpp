@@ -182,6 +182,31 @@ std::string validation_csv(const FitValidation& v) {
   return out;
 }
 
+namespace {
+
+// NaN (an interval Gauss-Newton could not give) as null: JSON has no NaN.
+nlohmann::ordered_json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
+
+nlohmann::ordered_json refinement_json(const RefineSummary& r) {
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::array(), records = nlohmann::ordered_json::array();
+  for (const auto& q : r.parameters)
+    parameters.push_back({{"name", q.name}, {"equation_error", q.linear}, {"refined", q.refined}, {"standard_error", finite_or_null(q.standard_error)}});
+  for (const auto& rec : r.records) {
+    nlohmann::ordered_json state = nlohmann::ordered_json::object(), before = nlohmann::ordered_json::object(),
+                           after = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : rec.initial_state) state[name] = value;
+    for (const auto& [name, value] : rec.rms_before) before[name] = value;
+    for (const auto& [name, value] : rec.rms_after) after[name] = value;
+    records.push_back({{"path", rec.path}, {"first_sample", rec.first_sample}, {"samples", rec.samples}, {"initial_state", std::move(state)},
+                       {"rms_error_before", std::move(before)}, {"rms_error_after", std::move(after)}});
+  }
+  return {{"status", to_string(r.status)}, {"message", r.message},      {"iterations", r.iterations},
+          {"residuals", r.residuals},     {"unknowns", r.unknowns},    {"cost_before", r.cost_before},
+          {"cost_after", r.cost_after},   {"parameters", std::move(parameters)}, {"records", std::move(records)}};
+}
+
+}  // namespace
+
 std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& f) {
   std::error_code ec;
   fs::create_directories(directory, ec);
@@ -202,6 +227,7 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
     choice = {{"chosen", f.form_choice->scores[f.form_choice->chosen].name}, {"forms", std::move(forms)}};
   }
   json["form_choice"] = std::move(choice);
+  json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
   const bool curves = f.validation && !f.validation->runs.empty();
   std::string why;
   std::optional<Diagnostic> problem;  // why the residual rows could not be had

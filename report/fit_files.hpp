@@ -17,6 +17,7 @@
 #include "runtime/select/select.hpp"
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
+#include "runtime/refine/refine.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
@@ -39,6 +40,9 @@ struct FitFiles {
   // The form chosen from the data (form_choice.hpp) when the model names none and validation ran;
   // null otherwise (fit.json's `form_choice` is then null; each equation still gives its `form`).
   const FormChoice* form_choice;
+  // The output-error refinement (runtime/refine/refine.hpp) when one was asked for; null otherwise
+  // (fit.json's `refinement` is then null).
+  const RefineSummary* refinement = nullptr;
 };
 
 // Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating

@@ -44,9 +44,10 @@ std::size_t start_segment_samples(std::size_t compared) {
   return std::min(compared, std::clamp<std::size_t>(compared / 10, 20, 1000));
 }
 
-std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
-                                                     const SampledRecord& record, const ValidationOptions& options) {
-  SimulateOptions o;
+std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
+                                               const SampledRecord& record, const ValidationOptions& options) {
+  RecordRun run;
+  SimulateOptions& o = run.options;
   o.method = options.method;
   o.substeps = options.substeps;
   o.absolute_tolerance = o.relative_tolerance = options.tolerance;
@@ -85,16 +86,27 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   auto initial = initial_state_from_record(form, record, options.evaluation, start);
   if (auto* d = std::get_if<Diagnostic>(&initial)) return *d;
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
+  run.start = start;
+  run.truncated = static_cast<std::size_t>(to) < record.time.size();
+  for (const auto& out : form.outputs) {
+    const auto& column = record.signals.at(out.name);
+    run.recorded.emplace_back(column.begin() + from, column.begin() + to);
+  }
+  return run;
+}
+
+std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
+                                                     const SampledRecord& record, const ValidationOptions& options) {
+  auto prepared = record_run(normalized, form, parameters, record, options);
+  if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
+  RecordRun& prepared_run = std::get<RecordRun>(prepared);
+  SimulateOptions& o = prepared_run.options;
+  const std::vector<std::vector<double>>& recorded = prepared_run.recorded;  // per output, on o.time
 
   ValidationSummary v;
   v.record = record.path;
-  v.truncated = static_cast<std::size_t>(to) < record.time.size();
+  v.truncated = prepared_run.truncated;
   v.recorded_state = named_state(form, o.initial);
-  std::vector<std::vector<double>> recorded;  // per output, on o.time
-  for (const auto& out : form.outputs) {
-    const auto& column = record.signals.at(out.name);
-    recorded.emplace_back(column.begin() + from, column.begin() + to);
-  }
   v.initial_method = options.initial_state;
   if (options.initial_state == InitialState::estimate && o.time.size() >= 2) {
     const InitialStateEstimate estimate = estimate_initial_state(normalized, form, o, recorded, start_segment_samples(o.time.size()));
@@ -193,8 +205,9 @@ std::string ValidationSummary::report(const std::string& method) const {
 
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
-                           std::size_t max_samples, InitialState initial_state) {
+                           std::size_t max_samples, InitialState initial_state, const std::vector<double>* refined) {
   FitValidation v;
+  if (refined) v.method += ", with the parameters refined by the output error";
   v.max_samples = max_samples;
   if (!summary.is_solution_usable()) {
     v.note = "skipped: the fit is rank deficient, so its parameters are not worth simulating";
@@ -204,7 +217,7 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
     v.note = "skipped: " + d->message;
     return v;
   }
-  const std::vector<double> parameters = fitted_parameter_values(normalized, summary, 0.0);
+  const std::vector<double> parameters = refined ? *refined : fitted_parameter_values(normalized, summary, 0.0);
   ValidationOptions o;
   o.evaluation = evaluation;
   o.max_samples = max_samples;

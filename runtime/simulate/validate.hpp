@@ -99,6 +99,20 @@ struct ValidationSummary {
   std::string report(const std::string& method) const;
 };
 
+// A record made ready to be simulated (validate() and output-error refinement, runtime/refine/):
+// the grid from the first sample where every state derivative has its centred moving-arc
+// estimate (to ValidationOptions::max_samples), the record's inputs and initial values, the
+// recorded outputs on that grid, and the moving-arc initial state in options.initial.
+struct RecordRun {
+  SimulateOptions options;                    // method and steps from the ValidationOptions; `parameters` set
+  std::vector<std::vector<double>> recorded;  // per output of the form, on options.time
+  std::size_t start = 0;                      // the record's sample at options.time[0]
+  bool truncated = false;                     // max_samples stopped the grid before the record's end
+};
+// `record` must outlive the result (options.initial_value reads it).
+std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
+                                               const SampledRecord& record, const ValidationOptions& options);
+
 std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,
                                                      const SampledRecord& record, const ValidationOptions& options);
 
@@ -116,10 +130,13 @@ struct FitValidation {
 };
 
 // `records`: the fitted records first (`fitted_records` of them), then those given only to be
-// compared with. `form`: the compiled model's explicit form of `normalized`.
+// compared with. `form`: the compiled model's explicit form of `normalized`. `refined`: the
+// output-error refinement's parameters (by the normalized model's parameter) to solve with
+// instead of the fit's.
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
-                           std::size_t max_samples, InitialState initial_state = InitialState::estimate);
+                           std::size_t max_samples, InitialState initial_state = InitialState::estimate,
+                           const std::vector<double>* refined = nullptr);
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
 // with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record (its initial

@@ -114,6 +114,20 @@ std::variant<PointSum, Diagnostic> compile_point_sum(const ir::Sum& s, PointLayo
   return out;
 }
 
+namespace {
+
+// x^n for a factor's integer power by multiplication: std::pow's general algorithm costs more than
+// the rest of a right-hand side evaluation (y^3 in a Duffing term), and is no more exact for small n.
+double integer_power(double x, int n) {
+  if (n == 1) return x;
+  if (n < 0 || n > 8) return std::pow(x, n);
+  double p = 1;
+  for (int k = 0; k < n; ++k) p *= x;
+  return p;
+}
+
+}  // namespace
+
 double PointSum::factor(const Factor& f, const PointInstant& at) const {
   switch (f.op) {
     case Op::slot: return at.slots[static_cast<std::size_t>(f.index)];
@@ -166,7 +180,7 @@ double PointSum::sum(int index, const PointInstant& at) const {
         v *= x;
         continue;
       }
-      const double p = f.power == 1 ? x : f.power == 2 ? x * x : std::pow(x, f.power);
+      const double p = integer_power(x, f.power);
       if (v != 0.0 || std::isnan(p)) v *= p;
     }
     total += v;

@@ -44,11 +44,15 @@ struct Weighted {
 
 // The 4-point cubic through the samples around t (Lagrange form); the stencil shifts inward at
 // the ends of the grid. Exact for cubics, so the interpolation error is O(h^4), RK4's order.
-double interpolate_cubic(const std::vector<double>& time, const std::vector<double>& v, double t) {
+// `hint`: the sample interval the stepper is in, tried before a binary search.
+double interpolate_cubic(const std::vector<double>& time, const std::vector<double>& v, double t, std::size_t hint) {
   const std::size_t n = time.size();
   if (n == 1) return v[0];
-  auto upper = std::upper_bound(time.begin(), time.end(), t);
-  std::size_t k = upper == time.begin() ? 0 : static_cast<std::size_t>(upper - time.begin()) - 1;  // time[k] <= t
+  std::size_t k = hint;
+  if (!(hint + 1 < n && time[hint] <= t && t < time[hint + 1])) {
+    auto upper = std::upper_bound(time.begin(), time.end(), t);
+    k = upper == time.begin() ? 0 : static_cast<std::size_t>(upper - time.begin()) - 1;  // time[k] <= t
+  }
   if (k >= n - 1) k = n - 2;
   if (n < 4) {
     const double a = (t - time[k]) / (time[k + 1] - time[k]);
@@ -294,7 +298,8 @@ class System {
     const std::size_t k = form_->outputs.size(), n = state_size(), q_count = sensitivity_columns();
     const auto K = static_cast<Eigen::Index>(k), N = static_cast<Eigen::Index>(n), Q = static_cast<Eigen::Index>(q_count);
     // G = d(A z + r)/dx (k x n); C = G S + [H 0], H = d(A z + r)/dp (k x P).
-    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(K, N);
+    Eigen::MatrixXd& g = g_;
+    g.setZero(K, N);
     c_.setZero(K, Q);
     for (std::size_t i = 0; i < k; ++i) {
       const auto I = static_cast<Eigen::Index>(i);
@@ -312,13 +317,14 @@ class System {
     }
     const Eigen::Map<const Eigen::MatrixXd> s(state + n, N, Q);
     c_.noalias() += g * s;
-    const Eigen::MatrixXd dz = k == 1 ? Eigen::MatrixXd(-c_ / a_(0, 0)) : Eigen::MatrixXd(a_.partialPivLu().solve(-c_));
+    if (k == 1) c_ *= -1 / a_(0, 0);
+    else c_ = a_.partialPivLu().solve(-c_);  // now dz/dq
     Eigen::Map<Eigen::MatrixXd> ds(out + n, N, Q);
     for (std::size_t j = 0; j < k; ++j) {
       const std::size_t base = state_offset_[j];
       const int order = form_->outputs[j].order;
       for (int m = 0; m + 1 < order; ++m) ds.row(static_cast<Eigen::Index>(base) + m) = s.row(static_cast<Eigen::Index>(base) + m + 1);
-      ds.row(static_cast<Eigen::Index>(base) + order - 1) = dz.row(static_cast<Eigen::Index>(j));
+      ds.row(static_cast<Eigen::Index>(base) + order - 1) = c_.row(static_cast<Eigen::Index>(j));
     }
   }
 
@@ -334,7 +340,7 @@ class System {
     const std::vector<double>& time = options_->time;
     const std::size_t k = interval_;
     switch (s.hold) {
-      case ir::Signal::Hold::smooth: return interpolate_cubic(time, s.column, t);
+      case ir::Signal::Hold::smooth: return interpolate_cubic(time, s.column, t, k);
       case ir::Signal::Hold::held: return s.column[k];
       case ir::Signal::Hold::linear:
         if (time.size() < 2) return s.column[0];
@@ -353,7 +359,7 @@ class System {
   std::size_t parameters_ = 0;
   std::vector<std::vector<std::vector<Weighted>>> coefficient_partial_;  // [i][j][state component]
   std::vector<std::vector<Weighted>> rest_partial_;                      // [i][state component]
-  Eigen::MatrixXd a_, c_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
+  Eigen::MatrixXd a_, c_, g_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
   Eigen::VectorXd z_;      // the highest derivatives
   std::vector<PointSum> switching_;
   std::vector<Source> sources_;

@@ -308,8 +308,8 @@ std::string RefineSummary::report() const {
   std::string out = "Refined by the output error (thesis section 2-4's simulation as the fit criterion: Levenberg-Marquardt over the\n"
                     "parameters and each record's initial state, exact sensitivities):\n";
   if (status == Status::failed) return out + "  not refined: " + message + ".\n";
-  out += fmt::format("  {}; weighted cost {:.6g} -> {:.6g} over {} output samples, {} unknowns, {:.2f} s\n", message, cost_before, cost_after,
-                     residuals, unknowns, seconds);
+  out += fmt::format("  {}; weighted cost {:.6g} -> {:.6g} over {} output samples, {} unknowns\n", message, cost_before, cost_after,
+                     residuals, unknowns);
   if (!substeps.empty())
     out += fmt::format("  solved by RK4 with {} step(s) per sample interval (the fewest whose error stays below a hundredth of the noise)\n",
                        substeps.front());

@@ -42,6 +42,8 @@ class Builder {
           }
         } else if (f.kind == FactorKind::guard) {
           for (const auto& c : f.conditions) add_switching_function(ir::subtract(*c.lhs, *c.rhs));
+        } else if (f.kind == FactorKind::function && f.name == "sign") {  // a guard in disguise: it jumps where its argument is 0
+          add_switching_function(*f.argument);
         }
       }
     };

@@ -39,8 +39,9 @@ struct ExplicitForm {
   // A matching of equations to outputs (equation i is "the equation of" outputs[matched[i]]),
   // for messages; the runtime solves the whole linear system, so the choice does not matter.
   std::vector<int> matched;
-  // Every guard condition in the equations as `lhs - rhs`: where one changes sign a branch
-  // switches (eq. 4-1.2's damper), and a fixed-step solver locates that time.
+  // Every guard condition in the equations as `lhs - rhs`, and every argument of sign(): where one
+  // changes sign a branch switches (eq. 4-1.2's damper, Coulomb friction's sign(y')), and a
+  // fixed-step solver locates that time.
   std::vector<ir::Sum> switching_functions;
   std::size_t state_size() const;
 };

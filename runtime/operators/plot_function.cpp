@@ -45,7 +45,7 @@ std::variant<PlotCurve, Diagnostic> evaluate_plot_function(const ir::PlotFunctio
     // Both ends exact: low + i*(high - low)/(points - 1) would miss `high` by rounding.
     const double v = i == points - 1 ? high : low + (high - low) * i / (points - 1);
     slot[0] = v;
-    const PointInstant at{slot, 0, 0};
+    const PointInstant at{slot, 0, 0, {}};
     curve.x.push_back(v);
     curve.fitted.push_back(std::get<PointSum>(compiled).evaluate(at));
     if (truth) curve.truth.push_back(truth->evaluate(at));

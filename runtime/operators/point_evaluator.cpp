@@ -1,5 +1,7 @@
 #include "runtime/operators/point_evaluator.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <stdexcept>
 
@@ -73,6 +75,7 @@ class PointSumCompiler {
         c.op = n == "sin" ? Op::sin : n == "cos" ? Op::cos : n == "exp" ? Op::exp : n == "log" ? Op::log : n == "sqrt" ? Op::sqrt
              : n == "abs" ? Op::abs : n == "tanh" ? Op::tanh : Op::sign;
         c.index = nested(*f.argument, problem);
+        if (c.op == Op::sign) c.mode = mode_of(*f.argument);
         break;
       }
       case K::power:
@@ -89,6 +92,7 @@ class PointSumCompiler {
           cond.relation = f.conditions[i].relation;
           cond.lhs = nested(*f.conditions[i].lhs, problem);
           cond.rhs = nested(*f.conditions[i].rhs, problem);
+          cond.mode = mode_of(ir::subtract(*f.conditions[i].lhs, *f.conditions[i].rhs));
           out_.conditions_[static_cast<std::size_t>(c.index) + i] = cond;
         }
         break;
@@ -99,6 +103,13 @@ class PointSumCompiler {
       case K::test_function: throw std::logic_error("a test function reached the point evaluator (simulation solves the normalized model)");
     }
     return problem;
+  }
+
+  // The switching function this condition or sign() argument is, for frozen modes; -1 if none.
+  int mode_of(const ir::Sum& g) const {
+    const auto& list = options_.switching_functions;
+    const auto it = std::find(list.begin(), list.end(), g);
+    return it == list.end() ? -1 : static_cast<int>(it - list.begin());
   }
 
   PointSum& out_;
@@ -143,6 +154,8 @@ double PointSum::factor(const Factor& f, const PointInstant& at) const {
     case Op::abs: return std::abs(sum(f.index, at));
     case Op::tanh: return std::tanh(sum(f.index, at));
     case Op::sign: {
+      if (f.mode >= 0 && static_cast<std::size_t>(f.mode) < at.modes.size() && at.modes[static_cast<std::size_t>(f.mode)] != kLiveMode)
+        return at.modes[static_cast<std::size_t>(f.mode)];
       const double x = sum(f.index, at);
       return std::isnan(x) ? x : static_cast<double>((x > 0) - (x < 0));
     }
@@ -150,6 +163,14 @@ double PointSum::factor(const Factor& f, const PointInstant& at) const {
     case Op::guard: {
       for (int i = 0; i < f.count; ++i) {
         const Condition& c = conditions_[static_cast<std::size_t>(f.index + i)];
+        if (c.mode >= 0 && static_cast<std::size_t>(c.mode) < at.modes.size() && at.modes[static_cast<std::size_t>(c.mode)] != kLiveMode) {
+          const int m = at.modes[static_cast<std::size_t>(c.mode)];  // the sign of lhs - rhs, frozen
+          const bool frozen = c.relation == ir::Relation::less ? m < 0
+                            : c.relation == ir::Relation::less_equal ? m <= 0
+                            : c.relation == ir::Relation::greater ? m > 0 : m >= 0;
+          if (!frozen) return 0.0;
+          continue;
+        }
         const double l = sum(c.lhs, at), r = sum(c.rhs, at);
         if (std::isnan(l) || std::isnan(r)) return std::numeric_limits<double>::quiet_NaN();
         const bool holds = c.relation == ir::Relation::less ? l < r

@@ -37,11 +37,20 @@ class PointLayout {
   std::vector<std::pair<std::string, int>> slots_;
 };
 
-// One instant: slot values (PointLayout order), the time t and the window start t0.
+// A frozen mode that is not frozen: the condition or sign() is evaluated as usual.
+inline constexpr signed char kLiveMode = 2;
+
+// One instant: slot values (PointLayout order), the time t and the window start t0; and, while a
+// solver takes one step, the frozen modes: per switching function (PointCompileOptions), the sign
+// of its value at the step's start (-1, 0, 1, or kLiveMode), which every guard condition and sign()
+// built on it then uses instead of its value, so that a step that ends on a switch never samples
+// the next branch in its last stage (a discontinuous right-hand side inside an RK4 step costs it
+// its order, and the sensitivities their meaning). Empty: everything live.
 struct PointInstant {
   std::span<const double> slots;
   double t = 0;
   double t0 = 0;
+  std::span<const signed char> modes;
 };
 
 class PointSum {
@@ -58,6 +67,7 @@ class PointSum {
     int power = 1;         // integer power of the factor in its term
     int index = 0;         // slot, or nested sum (function/power), or first condition (guard)
     int count = 0;         // guard: number of conditions
+    int mode = -1;         // sign(): the switching function its argument is, or -1
     double value = 0;      // constant; power: exponent
   };
   struct Term {
@@ -70,6 +80,7 @@ class PointSum {
   struct Condition {
     int lhs = 0, rhs = 0;  // nested sums
     ir::Relation relation = ir::Relation::less;
+    int mode = -1;  // the switching function lhs - rhs is, or -1
   };
   double sum(int index, const PointInstant& at) const;
   double factor(const Factor& f, const PointInstant& at) const;
@@ -84,6 +95,10 @@ struct PointCompileOptions {
   // The value of an initial-value factor such as `y(0)` or `y'(t0)`; nullopt when it has none
   // (compilation then fails with a Diagnostic at the term). Unset: every such factor fails.
   std::function<std::optional<double>(const ir::Factor&)> initial_value;
+  // The switching functions whose frozen modes PointInstant::modes gives (ExplicitForm::
+  // switching_functions): a guard condition `lhs rel rhs` whose lhs - rhs, or a sign() whose
+  // argument, is one of them reads its mode there.
+  std::vector<ir::Sum> switching_functions;
 };
 
 // Compiles `s`; new signal derivatives get slots in `layout`.

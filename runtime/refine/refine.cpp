@@ -74,9 +74,18 @@ class RecordCost final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
     const bool jacobian = jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr);
-    auto s = simulate_at(x[0], x[1], jacobian, nullptr);
-    if (!s) return false;  // a rejected trial step: Ceres shrinks its trust region
-    const std::size_t k = form_.outputs.size(), p = model_.parameters.size(), n = state_.size(), columns = s->sensitivity_columns;
+    const std::size_t k = form_.outputs.size(), p = model_.parameters.size(), n = state_.size();
+    // Levenberg-Marquardt accepts most trial steps and then asks for the Jacobian at the point it has
+    // just evaluated: every run integrates the sensitivities too, and the last is kept for that request.
+    std::vector<double> key(x[0], x[0] + p);
+    key.insert(key.end(), x[1], x[1] + n);
+    if (key != cached_key_) {
+      cached_ = simulate_at(x[0], x[1], true, nullptr);
+      cached_key_ = std::move(key);
+    }
+    if (!cached_) return false;  // a rejected trial step: Ceres shrinks its trust region
+    const SimulationSummary* s = &*cached_;
+    const std::size_t columns = s->sensitivity_columns;
     for (std::size_t i = 0; i < rows(); ++i)
       for (std::size_t j = 0; j < k; ++j) {
         const std::size_t row = i * k + j;
@@ -92,6 +101,8 @@ class RecordCost final : public ceres::CostFunction {
     return true;
   }
 
+  const SimulationSummary* last_run() const { return cached_ ? &*cached_ : nullptr; }
+
   double rms(std::size_t output, const SimulationSummary& s) const {
     double total = 0;
     for (std::size_t i = 0; i < rows(); ++i) total += std::pow(run_.recorded[output][i] - s.outputs[output][i], 2);
@@ -102,6 +113,8 @@ class RecordCost final : public ceres::CostFunction {
   const ir::Model& model_;
   const ExplicitForm& form_;
   mutable RecordRun run_;  // its SimulateOptions take each trial's parameters and state
+  mutable std::optional<SimulationSummary> cached_;  // the last run, with sensitivities (nullopt: it failed)
+  mutable std::vector<double> cached_key_;           // at these parameters, then initial state
   std::vector<double> weights_;
   std::vector<std::pair<std::string, int>> state_;
 };
@@ -290,7 +303,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
         jacobian(row + static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p + r * n + q)) = jx[i * n + q];
     }
     row += static_cast<Eigen::Index>(m);
-    auto s = costs[r]->simulate_at(parameters.data(), states[r].data(), false, nullptr);
+    const SimulationSummary* s = costs[r]->last_run();  // the run Evaluate just made
     for (std::size_t j = 0; j < form.outputs.size() && s; ++j) summary.records[r].rms_after.emplace_back(form.outputs[j].name, costs[r]->rms(j, *s));
     summary.records[r].initial = costs[r]->state_map(states[r].data());
     summary.records[r].initial_state = costs[r]->named(states[r].data());

@@ -13,8 +13,8 @@
 // s_j)^2 over the model's parameters and the initial state of every record (several records: one
 // initial state each), starting from the equation-error estimate; s_j is output j's noise level
 // (runtime/operators/noise_level.hpp) so outputs of different size and noise weigh by their
-// likelihood. The Jacobian is exact for the RK4 run (sensitivities, not differences), except for
-// the jump a guard switch adds. A trial parameter set whose run diverges or becomes singular is a
+// likelihood. The Jacobian is exact for the RK4 run (sensitivities, not differences, with their
+// jump at each located switch of a guard or sign()). A trial parameter set whose run diverges or becomes singular is a
 // rejected step; a start that cannot be simulated, or a refinement that ends worse than it began,
 // keeps the equation-error estimate and says so (status and a sentence), never silently. The
 // covariance is Gauss-Newton's, sigma^2 (J^T J)^-1 with sigma^2 from the final residuals: honest

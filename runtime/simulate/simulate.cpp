@@ -76,6 +76,7 @@ class System {
   std::optional<Diagnostic> build(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& o) {
     form_ = &form;
     compile_options_.initial_value = o.initial_value;
+    compile_options_.switching_functions = form.switching_functions;
     options_ = &o;
     sensitivities_ = o.sensitivities;
     // A part whose parameter is 0 adds nothing to the equations, but its sensitivity is the part itself.
@@ -137,6 +138,17 @@ class System {
       auto c = compile_point_sum(g, layout_, compile_options_);
       if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
       switching_.push_back(std::get<PointSum>(std::move(c)));
+      if (!sensitivities_) continue;
+      // d g / d x_m, for the jump of the sensitivities where g changes sign.
+      switching_partial_.emplace_back();
+      for (const auto& output : form.outputs)
+        for (int order = 0; order < output.order; ++order) {
+          auto d = partial_derivative(g, output.name, order);
+          if (!d) return diag::simulate_estimated_derivative(output.span, prime(output.name, order));
+          auto pc = compile_point_sum(*d, layout_, compile_options_);
+          if (auto* e = std::get_if<Diagnostic>(&pc)) return *e;
+          switching_partial_.back().push_back(std::get<PointSum>(std::move(pc)));
+        }
     }
     // Where each slot's value comes from: the state, an input definition or an input column.
     std::size_t offset = 0;
@@ -207,14 +219,28 @@ class System {
       double v = 0;
       switch (s.kind) {
         case Source::Kind::state: v = state[s.index]; break;
-        case Source::Kind::definition: v = s.definition.evaluate({std::span<const double>(), t, options_->t0_for_tau}); break;
+        case Source::Kind::definition: v = s.definition.evaluate({std::span<const double>(), t, options_->t0_for_tau, {}}); break;
         case Source::Kind::column: v = recorded(s, t); break;
       }
       slots_[s.slot] = v;
     }
   }
 
-  PointInstant instant(double t) const { return {slots_, t, options_->t0_for_tau}; }
+  PointInstant instant(double t) const {
+    return {slots_, t, options_->t0_for_tau, frozen_ ? std::span<const signed char>(modes_) : std::span<const signed char>()};
+  }
+
+  // The modes of the step starting at (t, state): each switching function's sign there (kLiveMode
+  // where it is 0: the step itself decides), used by every stage until the next freeze or thaw.
+  void freeze(double t, const double* state) {
+    frozen_ = false;
+    std::vector<double> g;
+    switching_values(t, state, g);
+    modes_.resize(g.size());
+    for (std::size_t i = 0; i < g.size(); ++i) modes_[i] = g[i] > 0 ? 1 : g[i] < 0 ? -1 : kLiveMode;
+    frozen_ = true;
+  }
+  void thaw() { frozen_ = false; }
 
   // dstate/dt; false (and `trouble` set) when the highest derivatives cannot be solved for.
   bool derivative(double t, const double* state, double* out) {
@@ -279,10 +305,53 @@ class System {
     g.resize(switching_.size());
     if (switching_.empty()) return;
     fill(t, state);
-    const PointInstant at = instant(t);
+    const PointInstant at{slots_, t, options_->t0_for_tau, {}};  // always live: they decide the modes
     for (std::size_t i = 0; i < switching_.size(); ++i) g[i] = switching_[i].evaluate(at);
   }
   bool has_switches() const { return !switching_.empty(); }
+
+  // The sensitivities' jump where switching function g changes sign between (before, x_before)
+  // and (after, x_after): the state is continuous but the right-hand side jumps from f- to f+,
+  // and the switch time moves with every parameter, d tau/dq = -(g_x S)/(g_x f- + g_t), so
+  // S+ = S- + (f+ - f-) (g_x S-) / (g_x f- + g_t) (Hiskens and Pai, IEEE TCAS-I 47(2), 2000,
+  // eq. 12). g_t, where g reads t or an input, by a central difference in time at fixed state.
+  void jump_sensitivities(double before, std::vector<double>& x_before, double after, std::vector<double>& x_after) {
+    if (!sensitivities_ || switching_.empty()) return;
+    const std::size_t n = state_size(), columns = sensitivity_columns();
+    std::vector<double> g_before, g_after, f_before(x_before.size()), f_after(x_after.size());
+    switching_values(before, x_before.data(), g_before);
+    switching_values(after, x_after.data(), g_after);
+    // f- in the step's frozen modes, f+ in the modes after the switch.
+    if (!derivative(before, x_before.data(), f_before.data())) return;
+    freeze(after, x_after.data());
+    if (!derivative(after, x_after.data(), f_after.data())) return;
+    thaw();
+    for (std::size_t i = 0; i < switching_.size(); ++i) {
+      if (!(g_before[i] * g_after[i] < 0)) continue;
+      fill(before, x_before.data());
+      const PointInstant at{slots_, before, options_->t0_for_tau, {}};
+      std::vector<double> gx(n);
+      double speed = 0;  // dg/dt along the trajectory before the switch
+      for (std::size_t m = 0; m < n; ++m) {
+        gx[m] = switching_partial_[i][m].evaluate(at);
+        speed += gx[m] * f_before[m];
+      }
+      const double delta = 1e-6 * std::max(1.0, std::abs(before));
+      fill(before + delta, x_before.data());
+      const double up = switching_[i].evaluate({slots_, before + delta, options_->t0_for_tau, {}});
+      fill(before - delta, x_before.data());
+      const double down = switching_[i].evaluate({slots_, before - delta, options_->t0_for_tau, {}});
+      speed += (up - down) / (2 * delta);
+      if (!(std::abs(speed) > 0) || !std::isfinite(speed)) continue;  // grazing: no transversal crossing to move
+      for (std::size_t q = 0; q < columns; ++q) {
+        double* column = x_after.data() + n + q * n;
+        double moved = 0;
+        for (std::size_t m = 0; m < n; ++m) moved += gx[m] * column[m];
+        moved /= speed;
+        for (std::size_t m = 0; m < n; ++m) column[m] += (f_after[m] - f_before[m]) * moved;
+      }
+    }
+  }
 
   std::vector<std::size_t> state_offset_;
   std::size_t evaluations = 0;
@@ -362,6 +431,9 @@ class System {
   Eigen::MatrixXd a_, c_, g_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
   Eigen::VectorXd z_;      // the highest derivatives
   std::vector<PointSum> switching_;
+  std::vector<signed char> modes_;  // frozen modes of the current step (freeze())
+  bool frozen_ = false;
+  std::vector<std::vector<PointSum>> switching_partial_;  // [function][state component], with sensitivities
   std::vector<Source> sources_;
   std::vector<double> slots_;
   std::optional<double> initial_det_;
@@ -490,6 +562,7 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
         int located = 0;
         while (t < end) {
           double step = end - t;
+          if (locate) system.freeze(t, s.data());  // every stage of this step in the modes it starts in
           bool ok = rk4_step(system, t, s, step, next, k, tmp);
           if (ok && locate && located < 16) {
             system.switching_values(t, s.data(), g0);
@@ -504,6 +577,8 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
                 (any_sign_change(g0, g1) ? hi : lo) = mid;
               }
               if (ok) ok = rk4_step(system, t, s, hi, next, k, tmp);
+              if (ok && system.sensitivity_columns() > 0 && rk4_step(system, t, s, lo, trial, k, tmp))
+                system.jump_sensitivities(t + lo, trial, t + hi, next);
               step = hi;
               ++located;
               ++summary.switches;

@@ -6,8 +6,9 @@
 // derivative, parameters symbolic), runtime/operators/point_evaluator.hpp, Boost.Odeint (adaptive method).
 // Guarantees: the state is (y, y', ..., y^(n-1)) per output; at each instant the k x k linear
 // system of the highest derivatives is solved (k = 1: a division). Methods: classic fixed-step
-// RK4 with `substeps` steps per output interval, guard switches located by bisection on the
-// switching functions and stepped to exactly (so a branch change never falls inside a step); or
+// RK4 with `substeps` steps per output interval, guard and sign() switches located by bisection
+// on the switching functions and stepped to exactly, each step taken in the branches it starts in
+// (so a branch change never falls inside a step, not even in its last stage); or
 // Odeint's dopri5 / cash_karp with absolute and relative tolerances (the adaptive controller
 // shrinks its steps at a switch but does not locate it). Inputs bound to record columns are
 // interpolated between samples by the 4-point cubic through the neighbouring samples (RK4 needs
@@ -58,8 +59,8 @@ struct SimulateOptions {
   // Also integrate the sensitivities d y / d q of every output to every parameter of the normalized
   // model and every initial-state component (the variational equations, with Jacobians derived
   // symbolically by ir/differentiate.hpp): the exact Jacobian output-error refinement needs
-  // (runtime/refine/refine.hpp). Under RK4 they are the exact derivatives of the discrete run, except
-  // across a guard switch, whose jump in the sensitivities is not added.
+  // (runtime/refine/refine.hpp). Under RK4 they are the exact derivatives of the discrete run, with
+  // the jump each located switch of a guard or sign() adds (the switch time moves with q).
   bool sensitivities = false;
 
   bool is_valid(std::string* why) const;

@@ -106,5 +106,29 @@ TEST(Sensitivity, HeldInput) {
   EXPECT_LT(largest_sensitivity_error(m, o), 1e-6);
 }
 
+// Coulomb friction: the right-hand side jumps at every reversal of y', and the sensitivities jump
+// with it (the switch time moves with every parameter); differences of whole runs, whose switches
+// are located to 1e-13, see that jump.
+TEST(Sensitivity, JumpAtEachSwitchOfSign) {
+  const ir::Model m = normalized("input x = 0.5*cos(1.7*t)\noutput y\nparam J, c, f, k\nJ*y'' + c*y' + f*sign(y') + k*sin(y) = x\n");
+  ASSERT_EQ(form_of(m).switching_functions.size(), 1u);  // sign(y')'s argument, located like a guard
+  SimulateOptions o;
+  o.parameters = {1.0, 0.1, 0.05, 2.0};  // swings of about 0.3 rad that never stick
+  o.initial["y"] = {0.2, 0.3};  // y'(0) != 0: sign(y') is not differentiable where it starts at 0
+  o.time = grid(0, 10, 0.02);
+  EXPECT_LT(largest_sensitivity_error(m, o), 1e-5);
+}
+
+// A force that switches on where y crosses 0 (a spring with a preload on one side), and a
+// stiffness that changes there: the first jumps the right-hand side, the second only its slope.
+TEST(Sensitivity, JumpAtEachSwitchOfAGuard) {
+  const ir::Model m = normalized("input x = 2*cos(t)\noutput y\nparam a, b, c, d, e\na*y'' + d*y' + b*[y > 0]*y + c*[y <= 0]*y + e*[y > 0] = x\n");
+  SimulateOptions o;
+  o.parameters = {1.0, 1.0, 4.0, 0.2, 0.3};
+  o.initial["y"] = {0.5, 0.0};
+  o.time = grid(0, 15, 0.02);
+  EXPECT_LT(largest_sensitivity_error(m, o), 1e-5);
+}
+
 }  // namespace
 }  // namespace sidc

@@ -41,7 +41,7 @@ TEST(PointEvaluator, AgreesWithTheFormulaAndZeroesOffGuards) {
   std::vector<double> slots(layout.size());
   const double y = 0.5, yd = 0.3, t = 0.2, t0 = 0.05;
   for (std::size_t i = 0; i < layout.size(); ++i) slots[i] = layout.slots()[i].second == 0 ? y : yd;
-  const PointInstant at{slots, t, t0};
+  const PointInstant at{slots, t, t0, {}};
   EXPECT_NEAR(std::get<PointSum>(a).evaluate(at), std::sin(yd) + 2 * y * y + std::exp(t) * (t - t0) + std::sqrt(1 + y * y), 1e-14);
   // The guard [y > 1] is off: the term is 0 even though y' is not finite.
   for (std::size_t i = 0; i < layout.size(); ++i)

@@ -18,6 +18,7 @@
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/fit.hpp"
+#include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc {
@@ -25,6 +26,7 @@ namespace sidc {
 nlohmann::ordered_json fit_json(const FitSummary& summary, const CompiledModel& compiled, const std::string& compiled_path, const FitOptions& options);
 nlohmann::ordered_json validation_json(const FitValidation& validation);
 nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis);
+nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSummary& iv);
 // record,t, then per output: recorded, simulated, error; "" when nothing was simulated.
 std::string validation_csv(const FitValidation& validation);
 
@@ -39,6 +41,9 @@ struct FitFiles {
   // The form chosen from the data (form_choice.hpp) when the model names none and validation ran;
   // null otherwise (fit.json's `form_choice` is then null; each equation still gives its `form`).
   const FormChoice* form_choice;
+  // The instrumental-variable estimate (`--estimator iv`, `set estimator = iv`); null otherwise
+  // (fit.json's `instrumental_variables` is then null).
+  const InstrumentalVariablesSummary* instrumental_variables;
 };
 
 // Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating

@@ -20,8 +20,8 @@
 // constant, an input) is its own instrument; each iterate solves Z^T W Phi theta = Z^T W b by QR of
 // the weighted, scaled instruments (see instrumental_variables.cpp), its covariance is
 // sigma^2 (Z^T Phi)^-1 (Z^T Z) (Phi^T Z)^-1 with sigma^2 from the IV residuals b - Phi theta; the
-// iteration stops when no parameter moves by more than `tolerance` of itself (or of its standard
-// error, when that is larger) or after `max_iterations`. A solution that diverges, instruments that
+// iteration stops when no parameter moves by more than `tolerance` of itself (or of its
+// equation-error standard error, when that is larger) or after `max_iterations`. A solution that diverges, instruments that
 // cannot be evaluated or are dependent stop it with a sentence saying so, and the last estimate whose
 // equations could be solved is kept and named: never a silent fallback. Dense groups only (a streamed
 // group is said to be out of reach).

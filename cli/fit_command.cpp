@@ -18,6 +18,7 @@
 #include "compiler/pipeline.hpp"
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/queries.hpp"
+#include "ir/settings.hpp"
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
@@ -27,6 +28,7 @@
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/fitted_values.hpp"
+#include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/model_comparison.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
@@ -46,6 +48,7 @@ struct FitArguments {
   std::string plots;                  // --plots DIR
   std::string report;                 // --report FILE.html
   bool refine = false;                // --refine: output-error refinement after the linear fit
+  std::string estimator;              // --estimator least_squares|iv, over the model's `set estimator`
 };
 
 // The compiled model to fit when none is named: the most recently compiled *.sidc.json in the
@@ -114,6 +117,14 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
             << operator_report(summary.operators, options->evaluation);
   if (!is_static(model)) std::cout << "\n";
   std::cout << summary.full_report(model);
+  // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;
+  // validation, residual tests and pictures below stay those of the equation-error estimate.
+  std::optional<InstrumentalVariablesSummary> iv;
+  if (a.estimator.empty() ? estimator_setting(model.settings) == Estimator::instrumental_variables : a.estimator == "iv") {
+    iv = instrumental_variables(model, compiled->normalized, *compiled->explicit_form, records, *options, summary);
+    std::cout << "\n" << iv->full_report();
+    if (!iv->is_solution_usable()) std::cerr << render(cli_diag::instrumental_variables_not_converged(iv->statement)) << "\n";
+  }
 
   // Output-error refinement (issue 15): from the linear estimate, the parameters whose solved
   // equations reproduce the fitted records best. A failure keeps the linear estimate and says so.
@@ -161,7 +172,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
 
   if (!out_dir.empty()) {
     auto written = write_fit_files(out_dir, {*compiled, compiled_path, summary, *options, records, validation, residuals,
-                                             choice ? &*choice : nullptr, refinement ? &*refinement : nullptr});
+                                             choice ? &*choice : nullptr, refinement ? &*refinement : nullptr, iv ? &*iv : nullptr});
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
     if (paths.size() == 3) std::cerr << "wrote " << paths[0] << ", " << paths[1] << " and " << paths[2] << "\n";
@@ -220,6 +231,10 @@ void add_fit_command(CLI::App& app, int& exit_status) {
                   "The validation's initial state: `estimate` (least squares over the record's start, the default) or `record` "
                   "(the first sample and its moving-arc derivatives)")
       ->check(CLI::IsMember({"estimate", "record"}));
+  cmd->add_option("--estimator", a->estimator,
+                  "`least_squares` (equation error, the default) or `iv` (refined instrumental variables after it); overrides "
+                  "`set estimator`")
+      ->check(CLI::IsMember({"least_squares", "iv"}));
   cmd->add_option("--plots", a->plots, "Directory for the pictures (SVG and PNG, drawn by gnuplot): outputs, errors, functions, residual tests");
   cmd->add_option("--report", a->report, "Write a one-page HTML report with the fit's tables and pictures to this file");
   cmd->add_flag("--refine", a->refine,

@@ -125,6 +125,13 @@ Diagnostic rank_deficient() {
                  "drop one operation of each dependent group, or give the record more excitation");
 }
 
+Diagnostic instrumental_variables_not_converged(std::string_view statement) {
+  return message("iv-not-converged", fmt::format("instrumental variables: {}", statement),
+                 "the report's `Instrumental variables` section says which estimate it kept; the equation-error fit above is "
+                 "unchanged",
+                 Severity::warning);
+}
+
 Diagnostic pictures_of_several_models(std::size_t models) {
   return message("pictures-of-several-models", fmt::format("--plots and --report draw one model's fit, and {} models were given", models),
                  "fit the models together for the comparison table, and each alone with --plots or --report");

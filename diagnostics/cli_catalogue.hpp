@@ -49,6 +49,9 @@ Diagnostic initial_order_too_high(std::string_view text, std::string_view name, 
 Diagnostic cannot_validate(std::string_view record, const Diagnostic& why);
 Diagnostic rank_deficient();
 Diagnostic pictures_of_several_models(std::size_t models);
+// A warning: the instrumental-variable iteration (`--estimator iv`) did not converge; `statement`
+// says what happened and which estimate is kept (runtime/solve/instrumental_variables.hpp).
+Diagnostic instrumental_variables_not_converged(std::string_view statement);
 
 // ---- sidc select -------------------------------------------------------------------------------
 Diagnostic required_and_dropped(std::string_view name);

@@ -26,7 +26,8 @@ std::optional<int> whole_number(const std::string& text) {
 
 const std::vector<std::string>& setting_keys() {
   static const std::vector<std::string> keys{"integrate", "form", "constants", "derivative", "second_derivative", "edges",
-                                             "integration", "smooth_before_integration", "from", "to", "every", "step", "weights", "refine"};
+                                             "integration", "smooth_before_integration", "from", "to", "every", "step", "weights", "refine",
+                                             "estimator"};
   return keys;
 }
 
@@ -81,6 +82,10 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
   } else if (key == "refine") {
     if (value != "none" && value != "simulation")
       r.expected = "`simulation` (refine the fit by the error of the solved equations, `sidc fit --refine`) or `none`";
+  } else if (key == "estimator") {
+    if (value != "least_squares" && value != "iv")
+      r.expected = "`least_squares` (equation error, thesis section 2-1; the default) or `iv` (refined instrumental variables: "
+                   "instruments from the fitted equations solved without noise)";
   } else if (key == "step") {
     if (!positive_number(value)) r.expected = "a positive sampling step, e.g. `0.01`";
   } else {
@@ -98,6 +103,11 @@ void request_form(ir::IntegrationRequest& request, const std::string& form) {
   request.weak = form == "weak";
   request.count = form == "integrated" ? ir::IntegrationRequest::Count::automatic : ir::IntegrationRequest::Count::fixed;
   request.times = 0;
+}
+
+Estimator estimator_setting(const ir::Settings& settings) {
+  auto it = settings.values.find("estimator");
+  return it != settings.values.end() && it->second.text == "iv" ? Estimator::instrumental_variables : Estimator::least_squares;
 }
 
 EvaluationSettings evaluation_settings(const ir::Settings& settings) {

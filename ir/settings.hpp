@@ -54,6 +54,12 @@ bool refine_by_simulation(const ir::Settings& settings);
 
 // Typed settings from checked raw values (check_setting has accepted every one).
 EvaluationSettings evaluation_settings(const ir::Settings& settings);
+
+// `set estimator`: the equation-error least squares of thesis section 2-1 (`least_squares`, the
+// default), or that fit refined by instrumental variables (`iv`, runtime/solve/instrumental_variables.hpp).
+enum class Estimator { least_squares, instrumental_variables };
+Estimator estimator_setting(const ir::Settings& settings);
+
 // Reads `savgol(7, 3)` or `savgol(auto)`; nullopt if the text is not of that form with a valid
 // window and order.
 std::optional<MovingArc> parse_moving_arc(const std::string& text);

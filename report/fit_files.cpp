@@ -133,6 +133,23 @@ nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis) {
   return groups;
 }
 
+nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSummary& iv) {
+  using nlohmann::ordered_json;
+  auto optional = [](const std::optional<double>& x) { return x ? ordered_json(*x) : ordered_json(nullptr); };
+  ordered_json groups = ordered_json::array();
+  for (const auto& g : iv.groups) {
+    ordered_json parameters = ordered_json::array();
+    for (const auto& p : g.parameters)
+      parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}},
+                            {"equation_error_estimate", p.equation_error}});
+    groups.push_back({{"form", g.form}, {"n", g.n}, {"p", g.p}, {"residual_sd", g.residual_sd}, {"parameters", std::move(parameters)}});
+  }
+  return {{"termination", to_string(iv.termination)}, {"statement", iv.statement}, {"iterations", iv.iterations},
+          {"max_iterations", iv.max_iterations}, {"tolerance", iv.tolerance}, {"changes", iv.changes},
+          {"fit_percent", optional(iv.fit_percent)}, {"equation_error_fit_percent", optional(iv.equation_error_fit_percent)},
+          {"groups", std::move(groups)}};
+}
+
 nlohmann::ordered_json validation_json(const FitValidation& v) {
   using nlohmann::ordered_json;
   ordered_json j;
@@ -228,6 +245,7 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   }
   json["form_choice"] = std::move(choice);
   json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
+  json["instrumental_variables"] = f.instrumental_variables ? instrumental_variables_json(*f.instrumental_variables) : nlohmann::ordered_json(nullptr);
   const bool curves = f.validation && !f.validation->runs.empty();
   std::string why;
   std::optional<Diagnostic> problem;  // why the residual rows could not be had

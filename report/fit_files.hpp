@@ -19,6 +19,7 @@
 #include "runtime/simulate/validate.hpp"
 #include "runtime/refine/refine.hpp"
 #include "runtime/solve/fit.hpp"
+#include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc {
@@ -26,6 +27,7 @@ namespace sidc {
 nlohmann::ordered_json fit_json(const FitSummary& summary, const CompiledModel& compiled, const std::string& compiled_path, const FitOptions& options);
 nlohmann::ordered_json validation_json(const FitValidation& validation);
 nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis);
+nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSummary& iv);
 // record,t, then per output: recorded, simulated, error; "" when nothing was simulated.
 std::string validation_csv(const FitValidation& validation);
 
@@ -43,6 +45,9 @@ struct FitFiles {
   // The output-error refinement (runtime/refine/refine.hpp) when one was asked for; null otherwise
   // (fit.json's `refinement` is then null).
   const RefineSummary* refinement = nullptr;
+  // The instrumental-variable estimate (`--estimator iv`, `set estimator = iv`); null otherwise
+  // (fit.json's `instrumental_variables` is then null).
+  const InstrumentalVariablesSummary* instrumental_variables = nullptr;
 };
 
 // Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating

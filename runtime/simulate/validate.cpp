@@ -59,7 +59,7 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   auto chosen = state_operators_for_record(form, record, options.evaluation);
   if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
   for (const auto& out : form.outputs)
-    for (int m = 1; m < out.order; ++m) {
+    for (int m = 1; m < out.order && !options.from_first_sample; ++m) {
       DerivativeOptions centred = derivative_options_for(std::get<EvaluationOptions>(chosen), out.name, m);
       centred.edges = DerivativeOptions::Edges::drop;
       start = std::max(start, static_cast<std::size_t>(std::max(0, samples_lost_each_side(m, centred))));

@@ -69,6 +69,10 @@ struct ValidationOptions {
   // evaluation, 16 per sample: 10^7 samples would take minutes, so sidc fit bounds it.
   std::size_t max_samples = 0;
   InitialState initial_state = InitialState::estimate;
+  // Start at the record's first sample rather than at the first with a centred moving-arc estimate
+  // of every state derivative (the initial guess there comes from off-centre arcs): for a run whose
+  // outputs are needed at every sample (the instruments of runtime/solve/instrumental_variables.hpp).
+  bool from_first_sample = false;
 };
 
 struct OutputValidation {

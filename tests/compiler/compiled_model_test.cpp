@@ -66,6 +66,7 @@ set from = 0.1
 set to = 2.5
 set every = 2
 set step = 0.01
+set estimator = iv
 set integrate = 2
 set constants = initial
 a1*y' + a2*(y + 1)^-1 + a3*(y^2 + 1)^0.5 + a4*y(0.5) + a5*t0*y + a6*tau*z + a7*exp(z)*[x > 1 and x < 3] = g*x + u + y'(0)

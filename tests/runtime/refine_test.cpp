@@ -17,12 +17,8 @@ namespace {
 
 using testing::form_of;
 using testing::grid;
+using testing::normalized;
 
-ir::Model normalized(const std::string& text) {
-  CompileResult r = compile(std::make_shared<const SourceFile>("test.sid", text), {});
-  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
-  return *r.normalized;
-}
 
 // The model solved finely from `initial` with `truth`, sampled every `step` to `end`, Gaussian
 // noise of `share` of each output's standard deviation added.

@@ -15,12 +15,8 @@ namespace {
 
 using testing::form_of;
 using testing::grid;
+using testing::normalized;
 
-ir::Model normalized(const std::string& text) {
-  CompileResult r = compile(std::make_shared<const SourceFile>("test.sid", text), {});
-  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
-  return *r.normalized;
-}
 
 SimulationSummary run(const ir::Model& m, const ExplicitForm& f, const SimulateOptions& o) {
   auto r = simulate(m, f, o);

@@ -16,14 +16,10 @@
 namespace sidc {
 namespace {
 
-ir::Model normalized(const std::string& text) {
-  CompileResult r = compile(std::make_shared<const SourceFile>("test.sid", text), {});
-  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
-  return *r.normalized;
-}
 
 using testing::form_of;
 using testing::grid;
+using testing::normalized;
 
 SimulationSummary run(const ir::Model& m, const ExplicitForm& f, SimulateOptions o) {
   auto r = simulate(m, f, o);

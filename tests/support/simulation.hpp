@@ -1,5 +1,5 @@
-// Test support for the tests that simulate compiled models in-process (tests/runtime): the
-// explicit form of a normalized model, and a uniform time grid.
+// Test support for the tests that simulate compiled models in-process (tests/runtime): a model
+// compiled to its normalized form, its explicit form, and a uniform time grid.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -9,8 +9,16 @@
 #include <vector>
 
 #include "compiler/explicit_form_pass.hpp"
+#include "compiler/pipeline.hpp"
 
 namespace sidc::testing {
+
+// The normalized model of `text` (file name test.sid); a compile error fails the test.
+inline ir::Model normalized(const std::string& text) {
+  CompileResult r = compile(std::make_shared<const SourceFile>("test.sid", text), {});
+  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
+  return *r.normalized;
+}
 
 // The model's explicit form; a failure fails the test (and throws bad_variant_access).
 inline ExplicitForm form_of(const ir::Model& m) {

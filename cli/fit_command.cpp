@@ -137,6 +137,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
       RefineOptions ro;
       ro.evaluation = options->evaluation;
       ro.max_samples = a.validate_samples;
+      ro.from = options->from;
+      ro.to = options->to;
       std::vector<const SampledRecord*> fitted;
       for (const auto& r : records) fitted.push_back(&r);
       auto refined = refine(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form),

@@ -2,6 +2,7 @@
 #include "runtime/refine/refine.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <ceres/ceres.h>
 #include <chrono>
 #include <cmath>
@@ -171,6 +172,20 @@ std::optional<int> substeps_for(const ir::Model& model, const ExplicitForm& form
   return substeps;
 }
 
+// `record`'s samples within [from, to] (the fit's window): the refinement is fitted where the
+// equation-error fit was, and a section held out for testing stays out of both.
+SampledRecord window_of(const SampledRecord& record, std::optional<double> from, std::optional<double> to) {
+  std::size_t first = 0, last = record.time.size();
+  while (first < last && from && record.time[first] < *from - 1e-9 * record.step) ++first;
+  while (last > first && to && record.time[last - 1] > *to + 1e-9 * record.step) --last;
+  SampledRecord w = record;
+  const auto a = static_cast<std::ptrdiff_t>(first), b = static_cast<std::ptrdiff_t>(last);
+  w.time.assign(record.time.begin() + a, record.time.begin() + b);
+  for (auto& [name, values] : w.signals) values.assign(record.signals.at(name).begin() + a, record.signals.at(name).begin() + b);
+  if (!w.weights.empty()) w.weights.assign(record.weights.begin() + a, record.weights.begin() + b);
+  return w;
+}
+
 }  // namespace
 
 const char* to_string(RefineSummary::Status status) {
@@ -196,7 +211,14 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
   v.max_samples = options.max_samples;
   std::vector<std::unique_ptr<RecordCost>> costs;
   std::vector<std::vector<double>> states;  // per record, the initial-state block
-  for (const SampledRecord* record : records) {
+  std::vector<SampledRecord> windows;  // the records cut to the fit window, when it is set
+  windows.reserve(records.size());
+  for (const SampledRecord* whole : records) {
+    const SampledRecord* record = whole;
+    if (options.from || options.to) {
+      windows.push_back(window_of(*whole, options.from, options.to));
+      record = &windows.back();
+    }
     auto prepared = record_run(normalized, form, linear, *record, v);
     if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
     RecordRun& run = std::get<RecordRun>(prepared);
@@ -219,7 +241,9 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
     summary.substeps.push_back(run.options.substeps);
     RefinedRecord r;
     r.path = record->path;
-    r.first_sample = run.start;
+    r.first_sample = run.start + static_cast<std::size_t>(std::lower_bound(whole->time.begin(), whole->time.end(),
+                                                                             record->time.empty() ? 0.0 : record->time.front()) -
+                                                         whole->time.begin());
     r.samples = run.options.time.size();
     costs.push_back(std::make_unique<RecordCost>(normalized, form, std::move(run), std::move(weights)));
     states.push_back(costs.back()->state_vector(costs.back()->run().options.initial));

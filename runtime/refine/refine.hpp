@@ -23,6 +23,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -43,6 +44,7 @@ struct RefineOptions {
   // agrees with twice as many steps to a hundredth of the noise).
   int substeps = 0;
   std::size_t max_samples = 0;   // per record, from the validation's start (0 = all)
+  std::optional<double> from, to;  // the fit window (FitOptions): only its samples are compared
   EvaluationOptions evaluation;  // the fit's, for the moving-arc initial state
 };
 

@@ -81,11 +81,15 @@ class RecordCost final : public ceres::CostFunction {
     std::vector<double> key(x[0], x[0] + p);
     key.insert(key.end(), x[1], x[1] + n);
     if (key != cached_key_) {
-      cached_ = simulate_at(x[0], x[1], true, nullptr);
+      SimulateOptions& o = run_.options;
+      o.parameters.assign(x[0], x[0] + p);
+      o.initial = state_map(x[1]);
+      o.sensitivities = true;
+      cached_ok_ = !simulate_into(model_, form_, o, cached_).has_value() && cached_.completed();
       cached_key_ = std::move(key);
     }
-    if (!cached_) return false;  // a rejected trial step: Ceres shrinks its trust region
-    const SimulationSummary* s = &*cached_;
+    if (!cached_ok_) return false;  // a rejected trial step: Ceres shrinks its trust region
+    const SimulationSummary* s = &cached_;
     const std::size_t columns = s->sensitivity_columns;
     for (std::size_t i = 0; i < rows(); ++i)
       for (std::size_t j = 0; j < k; ++j) {
@@ -102,7 +106,7 @@ class RecordCost final : public ceres::CostFunction {
     return true;
   }
 
-  const SimulationSummary* last_run() const { return cached_ ? &*cached_ : nullptr; }
+  const SimulationSummary* last_run() const { return cached_ok_ ? &cached_ : nullptr; }
 
   double rms(std::size_t output, const SimulationSummary& s) const {
     double total = 0;
@@ -114,8 +118,9 @@ class RecordCost final : public ceres::CostFunction {
   const ir::Model& model_;
   const ExplicitForm& form_;
   mutable RecordRun run_;  // its SimulateOptions take each trial's parameters and state
-  mutable std::optional<SimulationSummary> cached_;  // the last run, with sensitivities (nullopt: it failed)
-  mutable std::vector<double> cached_key_;           // at these parameters, then initial state
+  mutable SimulationSummary cached_;        // the last run, with sensitivities (its arrays reused by the next)
+  mutable bool cached_ok_ = false;          // it completed
+  mutable std::vector<double> cached_key_;  // at these parameters, then initial state
   std::vector<double> weights_;
   std::vector<std::pair<std::string, int>> state_;
 };

@@ -95,24 +95,28 @@ class System {
     };
     // d/dx_m of a ParametricSum for each state component x_m: the Jacobian the variational
     // equations need, derived symbolically (ir/differentiate.hpp), weighted like the sum itself.
+    // The parameter values are fixed for the run, so each partial is one Sum, sum_k a_k d(term_k)/dx_m,
+    // compiled once: one evaluation per state component instead of one per term.
     auto partials = [&](const ParametricSum& p, std::vector<Weighted>& out) -> std::optional<Diagnostic> {
       out.assign(form.state_size(), {});
       std::size_t m = 0;
       for (const auto& output : form.outputs)
         for (int order = 0; order < output.order; ++order, ++m) {
+          ir::Sum total;
           auto add = [&](double w, const ir::Sum& s, Span span) -> std::optional<Diagnostic> {
             if (s.empty() || w == 0) return std::nullopt;
             auto d = partial_derivative(s, output.name, order);
             if (!d) return diag::simulate_estimated_derivative(span, prime(output.name, order));
-            if (d->empty()) return std::nullopt;
-            auto c = compile_point_sum(*d, layout_, compile_options_);
-            if (auto* e = std::get_if<Diagnostic>(&c)) return *e;
-            out[m].parts.push_back({w, -1, std::get<PointSum>(std::move(c))});
+            total = ir::add(total, w == 1 ? *d : ir::scale(*d, Number::real(w)));
             return std::nullopt;
           };
           if (auto d = add(1.0, p.constant, output.span)) return d;
           for (const auto& t : p.terms)
             if (auto d = add(o.parameters[static_cast<std::size_t>(t.parameter)], t.operation, output.span)) return d;
+          if (total.empty()) continue;
+          auto c = compile_point_sum(total, layout_, compile_options_);
+          if (auto* e = std::get_if<Diagnostic>(&c)) return *e;
+          out[m].parts.push_back({1.0, -1, std::get<PointSum>(std::move(c))});
         }
       return std::nullopt;
     };
@@ -182,14 +186,14 @@ class System {
           return diag::simulate_derivative_of_held_input(signal->hold_span.known() ? signal->hold_span : signal->span, name,
                                                          to_string(source.hold), prime(name, order));
         if (order == 0) {
-          source.column = column->second;
+          source.column = &column->second;  // the options outlive the run
         } else {  // a recorded input's derivative: the moving arc on the record, then interpolated
           DerivativeOptions d;
           d.edges = DerivativeOptions::Edges::shorten;
           const double step = o.time.size() > 1 ? (o.time.back() - o.time.front()) / static_cast<double>(o.time.size() - 1) : 1.0;
           auto estimate = estimate_derivative(column->second, step, order, d);
           if (auto* e = std::get_if<Diagnostic>(&estimate)) return *e;
-          source.column = std::get<std::vector<double>>(std::move(estimate));
+          source.owned = std::get<std::vector<double>>(std::move(estimate));
         }
       }
       sources_.push_back(std::move(source));
@@ -364,36 +368,49 @@ class System {
   // for the highest derivatives z, from A z + r = 0: A dz/dq = -(d(A z + r)/dx S + d(A z + r)/dp).
   // Integrated by the same RK4 steps as the state, S is the exact derivative of the discrete run.
   void sensitivity_derivative(const PointInstant& at, const double* state, double* out) {
+    // Plain loops over small row-major arrays: the sizes (k outputs, n states, Q columns) are a
+    // handful each, where dynamic Eigen matrices cost more in bookkeeping than in arithmetic.
     const std::size_t k = form_->outputs.size(), n = state_size(), q_count = sensitivity_columns();
-    const auto K = static_cast<Eigen::Index>(k), N = static_cast<Eigen::Index>(n), Q = static_cast<Eigen::Index>(q_count);
     // G = d(A z + r)/dx (k x n); C = G S + [H 0], H = d(A z + r)/dp (k x P).
-    Eigen::MatrixXd& g = g_;
-    g.setZero(K, N);
-    c_.setZero(K, Q);
+    g_.assign(k * n, 0.0);
+    c_.assign(k * q_count, 0.0);
     for (std::size_t i = 0; i < k; ++i) {
-      const auto I = static_cast<Eigen::Index>(i);
+      double* g = &g_[i * n];
+      double* c = &c_[i * q_count];
       auto add_parameters = [&](const Weighted& w, double factor) {
         for (std::size_t p = 0; p < w.parts.size(); ++p)
-          if (w.parts[p].parameter >= 0) c_(I, w.parts[p].parameter) += factor * w.values[p];
+          if (w.parts[p].parameter >= 0) c[w.parts[p].parameter] += factor * w.values[p];
       };
-      for (std::size_t m = 0; m < n; ++m) g(I, static_cast<Eigen::Index>(m)) += rest_partial_[i][m](at);
+      for (std::size_t m = 0; m < n; ++m)
+        if (!rest_partial_[i][m].parts.empty()) g[m] += rest_partial_[i][m](at);
       add_parameters(rest_[i], 1.0);
       for (std::size_t j = 0; j < k; ++j) {
         const double zj = z_(static_cast<Eigen::Index>(j));
-        for (std::size_t m = 0; m < n; ++m) g(I, static_cast<Eigen::Index>(m)) += zj * coefficient_partial_[i][j][m](at);
+        for (std::size_t m = 0; m < n; ++m)
+          if (!coefficient_partial_[i][j][m].parts.empty()) g[m] += zj * coefficient_partial_[i][j][m](at);
         add_parameters(coefficient_[i][j], zj);
       }
+      const double* sensitivity = state + n;  // column q of S starts at q * n
+      for (std::size_t q = 0; q < q_count; ++q)
+        for (std::size_t m = 0; m < n; ++m) c[q] += g[m] * sensitivity[q * n + m];
     }
-    const Eigen::Map<const Eigen::MatrixXd> s(state + n, N, Q);
-    c_.noalias() += g * s;
-    if (k == 1) c_ *= -1 / a_(0, 0);
-    else c_ = a_.partialPivLu().solve(-c_);  // now dz/dq
-    Eigen::Map<Eigen::MatrixXd> ds(out + n, N, Q);
-    for (std::size_t j = 0; j < k; ++j) {
-      const std::size_t base = state_offset_[j];
-      const int order = form_->outputs[j].order;
-      for (int m = 0; m + 1 < order; ++m) ds.row(static_cast<Eigen::Index>(base) + m) = s.row(static_cast<Eigen::Index>(base) + m + 1);
-      ds.row(static_cast<Eigen::Index>(base) + order - 1) = c_.row(static_cast<Eigen::Index>(j));
+    if (k == 1) {
+      const double scale = -1 / a_(0, 0);
+      for (double& v : c_) v *= scale;
+    } else {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> c(c_.data(), static_cast<Eigen::Index>(k),
+                                                                                         static_cast<Eigen::Index>(q_count));
+      c = a_.partialPivLu().solve(-c).eval();  // now dz/dq
+    }
+    for (std::size_t q = 0; q < q_count; ++q) {
+      const double* s = state + n + q * n;
+      double* ds = out + n + q * n;
+      for (std::size_t j = 0; j < k; ++j) {
+        const std::size_t base = state_offset_[j];
+        const auto order = static_cast<std::size_t>(form_->outputs[j].order);
+        for (std::size_t m = 0; m + 1 < order; ++m) ds[base + m] = s[base + m + 1];
+        ds[base + order - 1] = c_[j * q_count + q];
+      }
     }
   }
 
@@ -402,18 +419,21 @@ class System {
     ir::Signal::Hold hold = ir::Signal::Hold::smooth;  // of a column
     std::size_t slot = 0, index = 0;
     PointSum definition;
-    std::vector<double> column;
+    const std::vector<double>* column = nullptr;  // a recorded input's samples, in the options
+    std::vector<double> owned;                    // or its estimated derivative
+    const std::vector<double>& values() const { return column ? *column : owned; }
   };
   // A recorded input at t, within the current interval for a held or linear one.
   double recorded(const Source& s, double t) const {
     const std::vector<double>& time = options_->time;
     const std::size_t k = interval_;
+    const std::vector<double>& v = s.values();
     switch (s.hold) {
-      case ir::Signal::Hold::smooth: return interpolate_cubic(time, s.column, t, k);
-      case ir::Signal::Hold::held: return s.column[k];
+      case ir::Signal::Hold::smooth: return interpolate_cubic(time, v, t, k);
+      case ir::Signal::Hold::held: return v[k];
       case ir::Signal::Hold::linear:
-        if (time.size() < 2) return s.column[0];
-        return s.column[k] + (s.column[k + 1] - s.column[k]) * (t - time[k]) / (time[k + 1] - time[k]);
+        if (time.size() < 2) return v[0];
+        return v[k] + (v[k + 1] - v[k]) * (t - time[k]) / (time[k + 1] - time[k]);
     }
     return nan;
   }
@@ -428,8 +448,9 @@ class System {
   std::size_t parameters_ = 0;
   std::vector<std::vector<std::vector<Weighted>>> coefficient_partial_;  // [i][j][state component]
   std::vector<std::vector<Weighted>> rest_partial_;                      // [i][state component]
-  Eigen::MatrixXd a_, c_, g_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
+  Eigen::MatrixXd a_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
   Eigen::VectorXd z_;      // the highest derivatives
+  std::vector<double> g_, c_;  // the sensitivity equations' d(A z + r)/dx (k x n) and right-hand side (k x Q), row-major
   std::vector<PointSum> switching_;
   std::vector<signed char> modes_;  // frozen modes of the current step (freeze())
   bool frozen_ = false;
@@ -503,19 +524,30 @@ std::string SimulationSummary::brief_report() const {
   return out;  // `message` says why it stopped; callers print it as an error or a statement
 }
 
-std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& o) {
+std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& o, SimulationSummary& summary) {
   // Options are the caller's to check (SimulateOptions::is_valid): a bad one here is a bug.
   if (std::string why; !o.is_valid(&why)) throw std::logic_error("simulate: " + why);
   if (o.parameters.size() != normalized.parameters.size())
     throw std::logic_error(fmt::format("simulate: {} parameter values for {} parameters", o.parameters.size(), normalized.parameters.size()));
   System system;
   if (auto d = system.build(normalized, form, o)) return *d;
-  SimulationSummary summary;
-  summary.time = o.time;
+  // The summary's arrays are refilled in place: a refinement runs the same record dozens of times,
+  // and fresh arrays of its size cost more in page faults than the run in arithmetic.
+  {
+    auto time = std::move(summary.time);
+    auto outputs = std::move(summary.outputs);
+    auto sensitivity = std::move(summary.sensitivity);
+    summary = SimulationSummary{};
+    summary.time = std::move(time);
+    summary.outputs = std::move(outputs);
+    summary.sensitivity = std::move(sensitivity);
+  }
+  summary.time.assign(o.time.begin(), o.time.end());
   const std::size_t n = o.time.size();
-  for (const auto& out : form.outputs) {
-    summary.output_names.push_back(out.name);
-    summary.outputs.emplace_back(n, nan);
+  summary.outputs.resize(form.outputs.size());
+  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+    summary.output_names.push_back(form.outputs[j].name);
+    summary.outputs[j].assign(n, nan);
   }
   State s(system.vector_size(), 0.0);
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {
@@ -526,10 +558,12 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
   }
   const std::size_t n_state = system.state_size(), columns = system.sensitivity_columns();
   summary.sensitivity_columns = columns;
+  if (!columns) summary.sensitivity.clear();
   if (columns) {
     // d x(t0) / d x0 = I: the initial state's columns follow the parameters'.
     for (std::size_t m = 0; m < n_state; ++m) s[n_state + (o.parameters.size() + m) * n_state + m] = 1;
-    summary.sensitivity.assign(form.outputs.size(), std::vector<double>(n * columns, nan));
+    summary.sensitivity.resize(form.outputs.size());
+    for (auto& column : summary.sensitivity) column.assign(n * columns, nan);
   }
   auto record = [&](std::size_t row, const State& x) {
     for (std::size_t j = 0; j < form.outputs.size(); ++j) {
@@ -545,7 +579,7 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
   record(0, s);
   if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, o.time[0])) {
     stop(SimulationSummary::Status::diverged, *bad, o.time[0]);
-    return summary;
+    return std::nullopt;
   }
 
   if (o.method == SimulateOptions::Method::rk4) {
@@ -587,7 +621,7 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
           if (!ok) {
             stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
             summary.right_hand_sides = system.evaluations;
-            return summary;
+            return std::nullopt;
           }
           s.swap(next);
           t = step == end - t ? end : t + step;
@@ -595,7 +629,7 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
           if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
             stop(SimulationSummary::Status::diverged, *bad, t);
             summary.right_hand_sides = system.evaluations;
-            return summary;
+            return std::nullopt;
           }
         }
       }
@@ -663,17 +697,17 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
               const std::string why = too_small(stepper.current_time());
               stop(system.trouble ? SimulationSummary::Status::singular : SimulationSummary::Status::diverged, why, stepper.current_time());
               summary.right_hand_sides = system.evaluations;
-              return summary;
+              return std::nullopt;
             }
             if (system.trouble) {
               stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
               summary.right_hand_sides = system.evaluations;
-              return summary;
+              return std::nullopt;
             }
             if (auto bad = divergence(stepper.current_state(), form, system.state_offset_, o.divergence_bound, stepper.current_time())) {
               stop(SimulationSummary::Status::diverged, *bad, stepper.current_time());
               summary.right_hand_sides = system.evaluations;
-              return summary;
+              return std::nullopt;
             }
           }
           stepper.calc_state(o.time[row], s);
@@ -689,6 +723,12 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
     }
   }
   summary.right_hand_sides = system.evaluations;
+  return std::nullopt;
+}
+
+std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& o) {
+  SimulationSummary summary;
+  if (auto d = simulate_into(normalized, form, o, summary)) return *d;
   return summary;
 }
 
@@ -703,9 +743,9 @@ std::variant<EvaluationOptions, Diagnostic> state_operators_for_record(const Exp
 std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_state_from_record(const ExplicitForm& form,
                                                                                               const SampledRecord& record,
                                                                                               const EvaluationOptions& evaluation,
-                                                                                              std::size_t index) {
+                                                                                              std::size_t index, bool arcs_chosen) {
   std::map<std::string, std::vector<double>> initial;
-  auto chosen = state_operators_for_record(form, record, evaluation);
+  auto chosen = arcs_chosen ? std::variant<EvaluationOptions, Diagnostic>(evaluation) : state_operators_for_record(form, record, evaluation);
   if (auto* e = std::get_if<Diagnostic>(&chosen)) return *e;
   const EvaluationOptions& options = std::get<EvaluationOptions>(chosen);
   for (const auto& out : form.outputs) {

@@ -90,14 +90,18 @@ struct SimulationSummary {
 // the model (an input with no values, a term that has no value at a point); numerical trouble is
 // a status in the summary.
 std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options);
+// The same into `summary`, whose arrays are reused (a refinement runs one record many times).
+std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options,
+                                        SimulationSummary& summary);
 
 // y(t), y'(t), ..., y^(n-1)(t) of each output at sample `index` of a record, derivatives by the
 // moving arc with off-centre (shortened) windows at the edges, so the first sample has them;
-// under savgol(auto) the arc chosen for each output and order from this record, as fit chooses it.
+// under savgol(auto) the arc chosen for each output and order from this record, as fit chooses it
+// (`arcs_chosen`: `evaluation` is already state_operators_for_record's result for this record).
 std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_state_from_record(const ExplicitForm& form,
                                                                                               const SampledRecord& record,
                                                                                               const EvaluationOptions& evaluation,
-                                                                                              std::size_t index);
+                                                                                              std::size_t index, bool arcs_chosen = false);
 
 // `evaluation` with the arcs of the outputs' derivatives below their orders chosen for `record`
 // (operator_choice.hpp; unchanged without savgol(auto)).

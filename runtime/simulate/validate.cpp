@@ -83,7 +83,7 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   for (const auto& s : normalized.signals)
     if (s.kind == ir::Signal::Kind::input && !s.definition)
       if (auto it = record.signals.find(s.name); it != record.signals.end()) o.inputs[s.name].assign(it->second.begin() + from, it->second.begin() + to);
-  auto initial = initial_state_from_record(form, record, options.evaluation, start);
+  auto initial = initial_state_from_record(form, record, std::get<EvaluationOptions>(chosen), start, true);
   if (auto* d = std::get_if<Diagnostic>(&initial)) return *d;
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
   run.start = start;

@@ -54,25 +54,6 @@ class RecordCost final : public ceres::CostFunction {
     return out;
   }
 
-  // The run at (parameters, initial state); `why` says why it has no usable output.
-  std::optional<SimulationSummary> simulate_at(const double* parameters, const double* initial, bool sensitivities, std::string* why) const {
-    SimulateOptions& o = run_.options;
-    o.parameters.assign(parameters, parameters + model_.parameters.size());
-    o.initial = state_map(initial);
-    o.sensitivities = sensitivities;
-    auto r = simulate(model_, form_, o);
-    if (auto* d = std::get_if<Diagnostic>(&r)) {  // the model was simulated before: only a bug gets here
-      if (why) *why = d->message;
-      return std::nullopt;
-    }
-    auto& s = std::get<SimulationSummary>(r);
-    if (!s.completed()) {
-      if (why) *why = s.message;
-      return std::nullopt;
-    }
-    return std::move(s);
-  }
-
   bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
     const bool jacobian = jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr);
     const std::size_t k = form_.outputs.size(), p = model_.parameters.size(), n = state_.size();
@@ -107,6 +88,11 @@ class RecordCost final : public ceres::CostFunction {
   }
 
   const SimulationSummary* last_run() const { return cached_ok_ ? &cached_ : nullptr; }
+  // Why the last run gave no usable residuals.
+  std::string last_failure() const {
+    if (!cached_.completed()) return cached_.message;
+    return "its solution is not finite";
+  }
 
   double rms(std::size_t output, const SimulationSummary& s) const {
     double total = 0;
@@ -264,18 +250,17 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
   // The start must run: without a solution of the linear estimate's equations there is nothing to refine.
   double cost_before = 0;
   for (std::size_t r = 0; r < costs.size(); ++r) {
-    std::string why;
-    auto s = costs[r]->simulate_at(parameters.data(), states[r].data(), false, &why);
-    if (!s) {
-      summary.message = fmt::format("the equation-error estimate's equations cannot be solved over {} ({}); its estimate is kept",
-                                    records[r]->path, why);
-      return finish();
-    }
+    // This run (with sensitivities) is also the one Ceres asks for first: RecordCost keeps it.
     std::vector<double> residuals(static_cast<std::size_t>(costs[r]->num_residuals()));
     const double* blocks[2] = {parameters.data(), states[r].data()};
-    costs[r]->Evaluate(blocks, residuals.data(), nullptr);
+    if (!costs[r]->Evaluate(blocks, residuals.data(), nullptr)) {
+      summary.message = fmt::format("the equation-error estimate's equations cannot be solved over {} ({}); its estimate is kept",
+                                    records[r]->path, costs[r]->last_failure());
+      return finish();
+    }
     for (double e : residuals) cost_before += 0.5 * e * e;
-    for (std::size_t j = 0; j < form.outputs.size(); ++j) summary.records[r].rms_before.emplace_back(form.outputs[j].name, costs[r]->rms(j, *s));
+    for (std::size_t j = 0; j < form.outputs.size(); ++j)
+      summary.records[r].rms_before.emplace_back(form.outputs[j].name, costs[r]->rms(j, *costs[r]->last_run()));
     summary.residuals += residuals.size();
   }
   summary.cost_before = cost_before;

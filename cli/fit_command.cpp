@@ -118,7 +118,8 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   if (!is_static(model)) std::cout << "\n";
   std::cout << summary.full_report(model);
   // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;
-  // validation, residual tests and pictures below stay those of the equation-error estimate.
+  // validation solves with its estimate (or the refined one); residual tests and pictures stay
+  // those of the equation-error fit.
   std::optional<InstrumentalVariablesSummary> iv;
   if (a.estimator.empty() ? estimator_setting(model.settings) == Estimator::instrumental_variables : a.estimator == "iv") {
     iv = instrumental_variables(model, compiled->normalized, *compiled->explicit_form, records, *options, summary);
@@ -126,8 +127,14 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     if (!iv->is_solution_usable()) std::cerr << render(cli_diag::instrumental_variables_not_converged(iv->statement)) << "\n";
   }
 
-  // Output-error refinement (issue 15): from the linear estimate, the parameters whose solved
-  // equations reproduce the fitted records best. A failure keeps the linear estimate and says so.
+  // The estimate the fit stands by, in the derivative form's parameters: the IV one when it was
+  // asked for and usable, else the equation-error one. Refinement starts from it.
+  const std::vector<double> fitted_estimate =
+      iv && iv->is_solution_usable() ? instrumental_parameter_values(compiled->normalized, *iv, fitted_parameter_values(compiled->normalized, summary, 0.0))
+                                     : fitted_parameter_values(compiled->normalized, summary, 0.0);
+
+  // Output-error refinement (issue 15): from that estimate, the parameters whose solved equations
+  // reproduce the fitted records best. A failure keeps the estimate it started from and says so.
   std::optional<RefineSummary> refinement;
   if ((a.refine || refine_by_simulation(compiled->normalized.settings)) && summary.is_solution_usable()) {
     if (auto* d = std::get_if<Diagnostic>(&*compiled->explicit_form)) {
@@ -141,8 +148,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
       ro.to = options->to;
       std::vector<const SampledRecord*> fitted;
       for (const auto& r : records) fitted.push_back(&r);
-      auto refined = refine(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form),
-                            fitted_parameter_values(compiled->normalized, summary, 0.0), fitted, ro);
+      auto refined = refine(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form), fitted_estimate, fitted, ro);
       if (auto* problem = std::get_if<Diagnostic>(&refined)) return fail(render(*problem), exit_code::user_error);
       refinement = std::get<RefineSummary>(std::move(refined));
     }
@@ -164,7 +170,10 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (const auto& r : extra) checked.push_back(&r);
     validation = validate_fit(compiled->normalized, *compiled->explicit_form, summary, checked, records.size(), options->evaluation,
                               a.validate_samples, a.initial_state == "record" ? InitialState::record : InitialState::estimate,
-                              refinement && refinement->improved() ? &refinement->values : nullptr);
+                              refinement && refinement->improved() ? &refinement->values
+                              : iv && iv->is_solution_usable()      ? &fitted_estimate
+                                                                    : nullptr,
+                              refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables");
     if (validation->failed_record)
       return fail(render(cli_diag::cannot_validate(validation->failed_path, *validation->failed_record)), exit_code::user_error);
     std::cout << validation_report(*validation);

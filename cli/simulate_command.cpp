@@ -95,7 +95,14 @@ std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& mod
       for (const auto& p : g.value("parameters", nlohmann::json::array()))
         if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
           if (auto f = assign(p["name"].get<std::string>(), p["estimate"].get<double>(), true)) return *f;
-    // A fit refined by the output error (sidc fit --refine): its refined values are the fit's answer.
+    // A fit by instrumental variables (set estimator = iv) that converged, then one refined by the
+    // output error (sidc fit --refine): the last estimate made is the fit's answer.
+    const auto& iv = j.contains("instrumental_variables") ? j["instrumental_variables"] : nlohmann::json();
+    if (iv.is_object() && iv.value("termination", "") == "converged" && iv.contains("groups") && iv["groups"].is_array())
+      for (const auto& g : iv["groups"])
+        for (const auto& p : g.value("parameters", nlohmann::json::array()))
+          if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
+            if (auto f = assign(p["name"].get<std::string>(), p["estimate"].get<double>(), true)) return *f;
     const auto& refinement = j.contains("refinement") ? j["refinement"] : nlohmann::json();
     if (refinement.is_object() && refinement.value("status", "") != "failed" && refinement.contains("parameters") && refinement["parameters"].is_array())
       for (const auto& p : refinement["parameters"])

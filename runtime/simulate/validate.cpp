@@ -205,9 +205,10 @@ std::string ValidationSummary::report(const std::string& method) const {
 
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
-                           std::size_t max_samples, InitialState initial_state, const std::vector<double>* refined) {
+                           std::size_t max_samples, InitialState initial_state, const std::vector<double>* refined,
+                           const std::string& refined_by) {
   FitValidation v;
-  if (refined) v.method += ", with the parameters refined by the output error";
+  if (refined) v.method += ", with the parameters " + refined_by;
   v.max_samples = max_samples;
   if (!summary.is_solution_usable()) {
     v.note = "skipped: the fit is rank deficient, so its parameters are not worth simulating";

@@ -135,12 +135,12 @@ struct FitValidation {
 
 // `records`: the fitted records first (`fitted_records` of them), then those given only to be
 // compared with. `form`: the compiled model's explicit form of `normalized`. `refined`: the
-// output-error refinement's parameters (by the normalized model's parameter) to solve with
-// instead of the fit's.
+// parameters (by the normalized model's parameter) to solve with instead of the fit's, and
+// `refined_by` how they were had ("refined by the output error", "of instrumental variables").
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples, InitialState initial_state = InitialState::estimate,
-                           const std::vector<double>* refined = nullptr);
+                           const std::vector<double>* refined = nullptr, const std::string& refined_by = "refined by the output error");
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
 // with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record (its initial

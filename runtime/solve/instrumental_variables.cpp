@@ -495,4 +495,14 @@ InstrumentalVariablesSummary instrumental_variables(const ir::Model& model, cons
   return s;
 }
 
+std::vector<double> instrumental_parameter_values(const ir::Model& normalized, const InstrumentalVariablesSummary& iv,
+                                                  std::vector<double> fallback) {
+  fallback.resize(normalized.parameters.size(), 0.0);
+  for (const auto& g : iv.groups)
+    for (const auto& p : g.parameters)
+      if (p.index && !p.index->record && p.index->parameter < fallback.size() && normalized.parameters[p.index->parameter].name == p.name)
+        fallback[p.index->parameter] = p.value;
+  return fallback;
+}
+
 }  // namespace sidc

@@ -86,6 +86,11 @@ struct InstrumentalVariablesSummary {
 
 const char* to_string(InstrumentalVariablesSummary::Termination termination);
 
+// The kept IV estimate by the parameters of `normalized` (the derivative form, whose parameters
+// come first in the fitted model's order), `fallback`'s value where the IV summary has none.
+std::vector<double> instrumental_parameter_values(const ir::Model& normalized, const InstrumentalVariablesSummary& iv,
+                                                  std::vector<double> fallback);
+
 // `model`: the fitted (integrated, weak or derivative) model; `normalized` and `form`: its
 // derivative form and its explicit form (or why there is none), which are solved; `fitted`:
 // fit(model, records, options). Never fails: invalid options and every numerical problem are a

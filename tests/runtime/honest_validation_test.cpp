@@ -52,14 +52,8 @@ SampledRecord noisy_oscillator(const ir::Model& m, const ExplicitForm& f, double
   auto run = simulate(m, f, o);
   EXPECT_TRUE(std::holds_alternative<SimulationSummary>(run));
   std::vector<double> y = std::get<SimulationSummary>(run).outputs[0];
-  double mean = 0, squares = 0;
-  for (double v : y) mean += v;
-  mean /= static_cast<double>(y.size());
-  for (double v : y) squares += (v - mean) * (v - mean);
-  const double sd = std::sqrt(squares / static_cast<double>(y.size()));
   std::mt19937 engine(seed);
-  std::normal_distribution<double> noise(0.0, share * sd);
-  for (double& v : y) v += noise(engine);
+  testing::add_noise(y, share, engine);
   SampledRecord record;
   record.path = "noisy.csv";
   record.step = 0.02;

@@ -58,13 +58,8 @@ SampledRecord duffing_record(double share, unsigned seed) {
   auto run = simulate(*truth.normalized, form_of(*truth.normalized), o);
   EXPECT_TRUE(std::holds_alternative<SimulationSummary>(run));
   std::vector<double> y = std::get<SimulationSummary>(run).outputs[0];
-  double mean = 0, squares = 0;
-  for (double v : y) mean += v / static_cast<double>(y.size());
-  for (double v : y) squares += (v - mean) * (v - mean) / static_cast<double>(y.size());
   std::mt19937 engine(seed);
-  std::normal_distribution<double> noise(0.0, share * std::sqrt(squares));
-  if (share > 0)
-    for (double& v : y) v += noise(engine);
+  if (share > 0) testing::add_noise(y, share, engine);
   SampledRecord record;
   record.path = "duffing.csv";
   record.step = 0.05;

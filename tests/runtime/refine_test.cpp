@@ -40,12 +40,7 @@ SampledRecord noisy_record(const ir::Model& m, const ExplicitForm& f, const std:
   std::mt19937 engine(seed);
   for (std::size_t j = 0; j < f.outputs.size(); ++j) {
     std::vector<double> y = s.outputs[j];
-    double mean = 0, squares = 0;
-    for (double v : y) mean += v;
-    mean /= static_cast<double>(y.size());
-    for (double v : y) squares += (v - mean) * (v - mean);
-    std::normal_distribution<double> noise(0.0, share * std::sqrt(squares / static_cast<double>(y.size())));
-    for (double& v : y) v += noise(engine);
+    testing::add_noise(y, share, engine);
     record.signals[f.outputs[j].name] = std::move(y);
   }
   return record;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <variant>
 #include <vector>
 
@@ -33,6 +34,17 @@ inline std::vector<double> grid(double t0, double t1, double step) {
   const auto n = static_cast<std::size_t>(std::llround((t1 - t0) / step));
   for (std::size_t i = 0; i <= n; ++i) t.push_back(t0 + static_cast<double>(i) * step);
   return t;
+}
+
+// Gaussian noise of `share` times the standard deviation of `y` added to every sample of `y`
+// (the known-truth records' convention: noise as a share of the signal's spread).
+inline void add_noise(std::vector<double>& y, double share, std::mt19937& engine) {
+  double mean = 0, squares = 0;
+  for (double v : y) mean += v;
+  mean /= static_cast<double>(y.size());
+  for (double v : y) squares += (v - mean) * (v - mean);
+  std::normal_distribution<double> noise(0.0, share * std::sqrt(squares / static_cast<double>(y.size())));
+  for (double& v : y) v += noise(engine);
 }
 
 }  // namespace sidc::testing

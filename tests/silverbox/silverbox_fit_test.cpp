@@ -277,4 +277,61 @@ TEST_F(Silverbox, IntegratedFormAgreesWithDerivativeForm) {
   EXPECT_NEAR(k3m_i, k3m_d, 0.40 * k3m_d);
 }
 
+// Issue 15's Silverbox target: refined by the output error on the train/validation section (the
+// fit window), the equations solved over the benchmark's test section [105712, 127400) from the
+// record's state there (the first 50 samples left out, as the benchmark does) reproduce the
+// measured output to at most 0.5 mV RMS (measured 0.43 mV), where the equation-error estimate
+// misses by more (0.89 mV): the test can fail either way.
+std::string exact(double v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << v;
+  return out.str();
+}
+
+double test_section_rms(const fs::path& work, const fs::path& fit_json, const std::string& name) {
+  constexpr std::size_t kTestFirst = 105712, kTestLast = 127400, kSettle = 50;
+  const std::string binary = shell_quoted(fs::path(SIDC_BINARY));
+  const fs::path out = work / (name + ".test.csv"), log = work / (name + ".test.log");
+  const std::string command = binary + " simulate " + shell_quoted(work / "derivative_form.sid") + " --params " + shell_quoted(fit_json) +
+                              " --t0 " + exact(kTestFirst * kStep) + " --t1 " + exact((kTestLast - 1) * kStep) +
+                              " --substeps 8 -o " + shell_quoted(out);
+  if (std::system(("(" + command + ") >" + shell_quoted(log) + " 2>&1").c_str()) != 0) {
+    ADD_FAILURE() << "command failed: " << command << "\n" << read_text(log);
+    return NAN;
+  }
+  const Record record = read_record(work / "SNLS80mV.csv");
+  std::istringstream lines(read_text(out));
+  std::string line;
+  std::getline(lines, line);  // t,V2
+  double squares = 0;
+  std::size_t k = 0, n = 0;
+  for (; std::getline(lines, line); ++k) {
+    if (k < kSettle || line.empty()) continue;
+    // Each row compared with the record's sample at its own time: t = index * step.
+    const auto index = static_cast<std::size_t>(std::llround(std::stod(line.substr(0, line.find(','))) / kStep));
+    const double simulated = std::stod(line.substr(line.find(',') + 1));
+    if (index >= record.y.size()) break;
+    squares += std::pow(simulated - record.y[index], 2);
+    ++n;
+  }
+  EXPECT_GT(n, 20000u) << "the simulation did not cover the test section";
+  return n ? std::sqrt(squares / static_cast<double>(n)) : NAN;
+}
+
+TEST_F(Silverbox, RefinedFitSimulatesTheTestSectionWithinHalfAMillivolt) {
+  const std::string binary = shell_quoted(fs::path(SIDC_BINARY));
+  const fs::path log = work_ / "refined.log";
+  const std::string command = binary + " fit " + shell_quoted(work_ / "derivative_form.sidc.json") + " --refine --no-validate --out " +
+                              shell_quoted(work_ / "out.refined");
+  ASSERT_EQ(std::system(("(" + command + ") >" + shell_quoted(log) + " 2>&1").c_str()), 0) << read_text(log);
+  const json refined = json::parse(read_text(work_ / "out.refined" / "fit.json")).at("refinement");
+  ASSERT_EQ(refined.at("status"), "converged") << refined.dump(1);
+  const double equation_error = test_section_rms(work_, work_ / "out.derivative_form" / "fit.json", "equation_error");
+  const double output_error = test_section_rms(work_, work_ / "out.refined" / "fit.json", "refined");
+  std::cout << "test section RMS error: equation error " << 1000 * equation_error << " mV, refined " << 1000 * output_error << " mV\n";
+  EXPECT_LT(output_error, 0.5e-3);
+  EXPECT_GT(equation_error, 0.5e-3);
+}
+
 }  // namespace

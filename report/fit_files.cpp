@@ -219,7 +219,8 @@ nlohmann::ordered_json refinement_json(const RefineSummary& r) {
   }
   return {{"status", to_string(r.status)}, {"message", r.message},      {"iterations", r.iterations},
           {"residuals", r.residuals},     {"unknowns", r.unknowns},    {"cost_before", r.cost_before},
-          {"cost_after", r.cost_after},   {"seconds", r.seconds}, {"parameters", std::move(parameters)}, {"records", std::move(records)}};
+          {"cost_after", r.cost_after},   {"seconds", r.seconds}, {"output_error_white", r.output_error_white},
+          {"parameters", std::move(parameters)}, {"records", std::move(records)}};
 }
 
 }  // namespace

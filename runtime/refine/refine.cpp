@@ -12,6 +12,7 @@
 #include "runtime/operators/noise_level.hpp"
 #include "runtime/simulate/initial_state.hpp"
 #include "runtime/simulate/validate.hpp"
+#include "runtime/solve/residual_correlation.hpp"
 
 namespace sidc {
 namespace {
@@ -301,6 +302,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
   // The Jacobian at the estimate, for the covariance and the final errors.
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(summary.residuals), static_cast<Eigen::Index>(summary.unknowns));
   Eigen::Index row = 0;
+  std::vector<std::vector<std::vector<double>>> output_errors(form.outputs.size());  // per output, per record
   for (std::size_t r = 0; r < costs.size(); ++r) {
     const std::size_t m = static_cast<std::size_t>(costs[r]->num_residuals()), n = costs[r]->state_size();
     std::vector<double> residuals(m), jp(m * p), jx(m * n);
@@ -318,9 +320,24 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
     }
     row += static_cast<Eigen::Index>(m);
     const SimulationSummary* s = costs[r]->last_run();  // the run Evaluate just made
-    for (std::size_t j = 0; j < form.outputs.size() && s; ++j) summary.records[r].rms_after.emplace_back(form.outputs[j].name, costs[r]->rms(j, *s));
+    for (std::size_t j = 0; j < form.outputs.size() && s; ++j) {
+      summary.records[r].rms_after.emplace_back(form.outputs[j].name, costs[r]->rms(j, *s));
+      std::vector<double> e(costs[r]->rows());
+      for (std::size_t i = 0; i < e.size(); ++i) e[i] = costs[r]->run().recorded[j][i] - s->outputs[j][i];
+      output_errors[j].push_back(std::move(e));
+    }
     summary.records[r].initial = costs[r]->state_map(states[r].data());
     summary.records[r].initial_state = costs[r]->named(states[r].data());
+  }
+  // The intervals assume white output errors (measurement noise): test each output's, record by
+  // record, as the fit's residual analysis tests the equation residuals.
+  summary.output_error_white = true;
+  for (std::size_t j = 0; j < output_errors.size(); ++j) {
+    if (output_errors[j].empty()) continue;
+    const ResidualCorrelationSummary c = residual_correlation(output_errors[j], {}, ResidualCorrelationOptions{});
+    if (!c.is_usable()) continue;
+    summary.output_error_white = summary.output_error_white && c.autocorrelation.white;
+    summary.whiteness.emplace_back(form.outputs[j].name, c.autocorrelation.verdict);
   }
   if (jacobian.size() > 0 && summary.residuals > summary.unknowns) {
     const double sigma2 = 2 * summary.cost_after / static_cast<double>(summary.residuals - summary.unknowns);
@@ -357,8 +374,14 @@ std::string RefineSummary::report() const {
     for (const auto& [name, value] : r.initial_state) out += fmt::format(" {} = {:.6g}", name, value);
     out += "\n";
   }
-  out += "  The intervals are Gauss-Newton's from the output error, which is the record's measurement noise when the\n"
-         "  model is right: unlike the equation error's, they do not assume white equation residuals.\n";
+  for (const auto& [output, verdict] : whiteness) out += fmt::format("  output error of {}: {}\n", output, verdict);
+  if (output_error_white)
+    out += "  The intervals are Gauss-Newton's from the output error, which is the record's measurement noise when the\n"
+           "  model is right, and it looks white: their assumption holds.\n";
+  else
+    out += "  The intervals are Gauss-Newton's from the output error and assume it white; it is not: the model misses part of\n"
+           "  the record, or the noise is coloured, and the intervals are too narrow. The solved equations against the\n"
+           "  record (validation) are the test to trust.\n";
   return out;
 }
 

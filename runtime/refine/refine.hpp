@@ -76,6 +76,10 @@ struct RefineSummary {
   std::vector<RefinedRecord> records;
   std::vector<std::pair<std::string, double>> output_noise;  // s_j: the weights' scale per output
   std::vector<int> substeps;                                  // RK4 steps per sample interval, per record
+  // The whiteness test of each output's error (runtime/solve/residual_correlation.hpp, over the
+  // records): the intervals assume it white; `whiteness` has each output's one-line verdict.
+  bool output_error_white = true;
+  std::vector<std::pair<std::string, std::string>> whiteness;
   double seconds = 0;
   bool improved() const { return status != Status::failed; }
   std::string report() const;

@@ -74,8 +74,22 @@ TEST(Refine, VanDerPolFromABiasedStartReachesTheMinimumTheTruthReaches) {
   const RefineSummary from_truth = refined(m, f, truth, {&record});
   EXPECT_NEAR(from_truth.cost_after, from_biased.cost_after, 1e-6 * from_biased.cost_after);
   for (std::size_t q = 0; q < truth.size(); ++q) EXPECT_NEAR(from_truth.values[q], from_biased.values[q], 1e-5);
-  // The output error is the noise: its weighted cost is about half the number of samples.
+  // The output error is the noise: its weighted cost is about half the number of samples, and white.
   EXPECT_NEAR(from_biased.cost_after / static_cast<double>(from_biased.residuals), 0.5, 0.1);
+  EXPECT_TRUE(from_biased.output_error_white) << from_biased.report();
+}
+
+// A model without the cubic refined on a Duffing record: the best it can do leaves the cubic's
+// effect in the output error, which the whiteness test sees and the report turns into a warning
+// about the intervals.
+TEST(Refine, AMissingTermLeavesAnOutputErrorThatIsNotWhite) {
+  const ir::Model duffing = normalized("input x = cos(1.3*t)\noutput y\nparam m, c, k, k3\nm*y'' + c*y' + k*y + k3*y^3 = x\n");
+  const SampledRecord record = noisy_record(duffing, form_of(duffing), {1, 0.25, 1, 0.5}, {{"y", {0.5, 0}}}, 30, 0.05, 0.01, 9);
+  const ir::Model linear = normalized("input x = cos(1.3*t)\noutput y\nparam m, c, k\nm*y'' + c*y' + k*y = x\n");
+  const RefineSummary r = refined(linear, form_of(linear), {1, 0.25, 1.3}, {&record});
+  ASSERT_TRUE(r.improved()) << r.message;
+  EXPECT_FALSE(r.output_error_white) << r.report();
+  EXPECT_NE(r.report().find("the intervals are too narrow"), std::string::npos);
 }
 
 TEST(Refine, IntervalsHoldTheTruthAtAboutTheirNominalRate) {

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "runtime/operators/noise_level.hpp"
+#include "runtime/records/sampling.hpp"
 #include "runtime/simulate/initial_state.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/residual_correlation.hpp"
@@ -17,47 +18,28 @@
 namespace sidc {
 namespace {
 
-std::string prime(const std::string& name, int order) { return name + std::string(static_cast<std::size_t>(order), '\''); }
-
 // One record's weighted output errors as a Ceres cost: parameter blocks are the model's
 // parameters (shared by every record) and this record's initial state.
 class RecordCost final : public ceres::CostFunction {
  public:
   RecordCost(const ir::Model& model, const ExplicitForm& form, RecordRun run, std::vector<double> weights)
       : model_(model), form_(form), run_(std::move(run)), weights_(std::move(weights)) {
-    for (const auto& out : form.outputs)
-      for (int m = 0; m < out.order; ++m) state_.emplace_back(out.name, m);
     set_num_residuals(static_cast<int>(rows() * form.outputs.size()));
     mutable_parameter_block_sizes()->push_back(static_cast<int>(model.parameters.size()));
-    mutable_parameter_block_sizes()->push_back(static_cast<int>(state_.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(state_size()));
   }
 
   std::size_t rows() const { return run_.options.time.size(); }
-  std::size_t state_size() const { return state_.size(); }
+  std::size_t state_size() const { return form_.state_size(); }
   const RecordRun& run() const { return run_; }
 
-  std::vector<double> state_vector(const std::map<std::string, std::vector<double>>& initial) const {
-    std::vector<double> x;
-    for (const auto& [name, m] : state_) {
-      auto it = initial.find(name);
-      x.push_back(it != initial.end() && static_cast<std::size_t>(m) < it->second.size() ? it->second[static_cast<std::size_t>(m)] : 0.0);
-    }
-    return x;
-  }
   std::map<std::string, std::vector<double>> state_map(const double* x) const {
-    std::map<std::string, std::vector<double>> initial;
-    for (std::size_t k = 0; k < state_.size(); ++k) initial[state_[k].first].push_back(x[k]);
-    return initial;
-  }
-  std::vector<std::pair<std::string, double>> named(const double* x) const {
-    std::vector<std::pair<std::string, double>> out;
-    for (std::size_t k = 0; k < state_.size(); ++k) out.emplace_back(prime(state_[k].first, state_[k].second), x[k]);
-    return out;
+    return sidc::state_map(form_, std::span<const double>(x, state_size()));
   }
 
   bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
     const bool jacobian = jacobians != nullptr && (jacobians[0] != nullptr || jacobians[1] != nullptr);
-    const std::size_t k = form_.outputs.size(), p = model_.parameters.size(), n = state_.size();
+    const std::size_t k = form_.outputs.size(), p = model_.parameters.size(), n = state_size();
     // Levenberg-Marquardt accepts most trial steps and then asks for the Jacobian at the point it has
     // just evaluated: every run integrates the sensitivities too, and the last is kept for that request.
     std::vector<double> key(x[0], x[0] + p);
@@ -109,7 +91,6 @@ class RecordCost final : public ceres::CostFunction {
   mutable bool cached_ok_ = false;          // it completed
   mutable std::vector<double> cached_key_;  // at these parameters, then initial state
   std::vector<double> weights_;
-  std::vector<std::pair<std::string, int>> state_;
 };
 
 // Gauss-Newton's standard errors of the first `parameters` unknowns: sigma^2 (J^T J)^-1, the
@@ -164,14 +145,12 @@ std::optional<int> substeps_for(const ir::Model& model, const ExplicitForm& form
   return substeps;
 }
 
-// `record`'s samples within [from, to] (the fit's window): the refinement is fitted where the
-// equation-error fit was, and a section held out for testing stays out of both.
-SampledRecord window_of(const SampledRecord& record, std::optional<double> from, std::optional<double> to) {
-  std::size_t first = 0, last = record.time.size();
-  while (first < last && from && record.time[first] < *from - 1e-9 * record.step) ++first;
-  while (last > first && to && record.time[last - 1] > *to + 1e-9 * record.step) --last;
+// `record`'s samples in `rows` (the fit's window, records/sampling.hpp's time_window): the
+// refinement is fitted where the equation-error fit was, and a section held out for testing stays
+// out of both.
+SampledRecord window_of(const SampledRecord& record, IndexRange rows) {
+  const auto a = static_cast<std::ptrdiff_t>(rows.begin), b = static_cast<std::ptrdiff_t>(rows.end);
   SampledRecord w = record;
-  const auto a = static_cast<std::ptrdiff_t>(first), b = static_cast<std::ptrdiff_t>(last);
   w.time.assign(record.time.begin() + a, record.time.begin() + b);
   for (auto& [name, values] : w.signals) values.assign(record.signals.at(name).begin() + a, record.signals.at(name).begin() + b);
   if (!w.weights.empty()) w.weights.assign(record.weights.begin() + a, record.weights.begin() + b);
@@ -207,8 +186,11 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
   windows.reserve(records.size());
   for (const SampledRecord* whole : records) {
     const SampledRecord* record = whole;
+    IndexRange rows{0, whole->time.size()};
     if (options.from || options.to) {
-      windows.push_back(window_of(*whole, options.from, options.to));
+      rows = time_window(whole->time, options.from.value_or(-std::numeric_limits<double>::infinity()),
+                         options.to.value_or(std::numeric_limits<double>::infinity()));
+      windows.push_back(window_of(*whole, rows));
       record = &windows.back();
     }
     auto prepared = record_run(normalized, form, linear, *record, v);
@@ -233,12 +215,10 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
     summary.substeps.push_back(run.options.substeps);
     RefinedRecord r;
     r.path = record->path;
-    r.first_sample = run.start + static_cast<std::size_t>(std::lower_bound(whole->time.begin(), whole->time.end(),
-                                                                             record->time.empty() ? 0.0 : record->time.front()) -
-                                                         whole->time.begin());
+    r.first_sample = rows.begin + run.start;
     r.samples = run.options.time.size();
     costs.push_back(std::make_unique<RecordCost>(normalized, form, std::move(run), std::move(weights)));
-    states.push_back(costs.back()->state_vector(costs.back()->run().options.initial));
+    states.push_back(state_vector(form, costs.back()->run().options.initial));
     summary.records.push_back(std::move(r));
   }
 
@@ -327,7 +307,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
       output_errors[j].push_back(std::move(e));
     }
     summary.records[r].initial = costs[r]->state_map(states[r].data());
-    summary.records[r].initial_state = costs[r]->named(states[r].data());
+    summary.records[r].initial_state = named_state(form, summary.records[r].initial);
   }
   // The intervals assume white output errors (measurement noise): test each output's, record by
   // record, as the fit's residual analysis tests the equation residuals.

@@ -29,30 +29,22 @@ class StartProblem {
       scale_.push_back(sd > 0 && std::isfinite(sd) ? sd : 1.0);
       // A typical size of y^(m) for the finite-difference steps: the spread over the segment's duration^m.
       for (int m = 0; m < form.outputs[j].order; ++m) {
-        layout_.emplace_back(form.outputs[j].name, m);
         typical_.push_back(scale_.back() / std::pow(duration > 0 ? duration : 1.0, m));
       }
     }
   }
 
-  std::size_t size() const { return layout_.size(); }
+  std::size_t size() const { return form_.state_size(); }
   std::size_t rows() const { return segment_ * form_.outputs.size(); }
   double typical(std::size_t k) const { return typical_[k]; }
 
   Eigen::VectorXd vector_of(const std::map<std::string, std::vector<double>>& initial) const {
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(size()));
-    for (std::size_t k = 0; k < layout_.size(); ++k) {
-      auto it = initial.find(layout_[k].first);
-      const auto m = static_cast<std::size_t>(layout_[k].second);
-      if (it != initial.end() && m < it->second.size()) x(static_cast<Eigen::Index>(k)) = it->second[m];
-    }
-    return x;
+    const std::vector<double> x = state_vector(form_, initial);
+    return Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size()));
   }
 
   std::map<std::string, std::vector<double>> map_of(const Eigen::VectorXd& x) const {
-    std::map<std::string, std::vector<double>> initial;
-    for (std::size_t k = 0; k < layout_.size(); ++k) initial[layout_[k].first].push_back(x(static_cast<Eigen::Index>(k)));
-    return initial;
+    return state_map(form_, std::span<const double>(x.data(), static_cast<std::size_t>(x.size())));
   }
 
   // (recorded - simulated) / s_j over the segment; false when the run fails or is not finite.
@@ -79,7 +71,6 @@ class StartProblem {
   const std::vector<std::vector<double>>& recorded_;
   std::size_t segment_;
   std::vector<double> scale_, typical_;
-  std::vector<std::pair<std::string, int>> layout_;  // (output, derivative order) per state component
 };
 
 }  // namespace

@@ -549,13 +549,8 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
     summary.output_names.push_back(form.outputs[j].name);
     summary.outputs[j].assign(n, nan);
   }
-  State s(system.vector_size(), 0.0);
-  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
-    auto it = o.initial.find(form.outputs[j].name);
-    for (int m = 0; m < form.outputs[j].order; ++m)
-      s[system.state_offset_[j] + static_cast<std::size_t>(m)] =
-          it != o.initial.end() && static_cast<std::size_t>(m) < it->second.size() ? it->second[static_cast<std::size_t>(m)] : 0.0;
-  }
+  State s = state_vector(form, o.initial);
+  s.resize(system.vector_size(), 0.0);
   const std::size_t n_state = system.state_size(), columns = system.sensitivity_columns();
   summary.sensitivity_columns = columns;
   if (!columns) summary.sensitivity.clear();
@@ -730,6 +725,26 @@ std::variant<SimulationSummary, Diagnostic> simulate(const ir::Model& normalized
   SimulationSummary summary;
   if (auto d = simulate_into(normalized, form, o, summary)) return *d;
   return summary;
+}
+
+std::vector<double> state_vector(const ExplicitForm& form, const std::map<std::string, std::vector<double>>& initial) {
+  std::vector<double> x;
+  for (const auto& out : form.outputs) {
+    auto it = initial.find(out.name);
+    for (int m = 0; m < out.order; ++m) {
+      const auto k = static_cast<std::size_t>(m);
+      x.push_back(it != initial.end() && k < it->second.size() ? it->second[k] : 0.0);
+    }
+  }
+  return x;
+}
+
+std::map<std::string, std::vector<double>> state_map(const ExplicitForm& form, std::span<const double> x) {
+  std::map<std::string, std::vector<double>> initial;
+  std::size_t k = 0;
+  for (const auto& out : form.outputs)
+    for (int m = 0; m < out.order && k < x.size(); ++m) initial[out.name].push_back(x[k++]);
+  return initial;
 }
 
 std::variant<EvaluationOptions, Diagnostic> state_operators_for_record(const ExplicitForm& form, const SampledRecord& record,

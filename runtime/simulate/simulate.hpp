@@ -26,6 +26,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <variant>
 #include <vector>
@@ -85,6 +86,12 @@ struct SimulationSummary {
   bool completed() const { return status == Status::completed; }
   std::string brief_report() const;
 };
+
+// The initial state as a vector in the explicit form's state order (per output, y, y', ...,
+// y^(n-1): the order of the state and of the initial-state sensitivity columns), a component
+// `initial` lacks as 0; and the vector back as SimulateOptions::initial.
+std::vector<double> state_vector(const ExplicitForm& form, const std::map<std::string, std::vector<double>>& initial);
+std::map<std::string, std::vector<double>> state_map(const ExplicitForm& form, std::span<const double> x);
 
 // Compiles the explicit form for point evaluation and runs the simulation. Diagnostics are for
 // the model (an input with no values, a term that has no value at a point); numerical trouble is

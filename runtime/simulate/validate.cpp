@@ -9,18 +9,17 @@
 #include "runtime/solve/fitted_values.hpp"
 
 namespace sidc {
-namespace {
 
 std::vector<std::pair<std::string, double>> named_state(const ExplicitForm& form, const std::map<std::string, std::vector<double>>& initial) {
+  const std::vector<double> x = state_vector(form, initial);
   std::vector<std::pair<std::string, double>> named;
+  std::size_t k = 0;
   for (const auto& out : form.outputs)
-    for (int m = 0; m < out.order; ++m) {
-      auto it = initial.find(out.name);
-      const auto k = static_cast<std::size_t>(m);
-      named.emplace_back(out.name + std::string(k, '\''), it != initial.end() && k < it->second.size() ? it->second[k] : 0.0);
-    }
+    for (int m = 0; m < out.order; ++m) named.emplace_back(out.name + std::string(static_cast<std::size_t>(m), '\''), x[k++]);
   return named;
 }
+
+namespace {
 
 // The first time the local RMS of `e` (kDepartureHalfWidth samples either side, those that are
 // finite) exceeds `limit`; none when it never does.

@@ -103,6 +103,9 @@ struct ValidationSummary {
   std::string report(const std::string& method) const;
 };
 
+// The state as printed: ("y", value), ("y'", value), ... in the explicit form's state order.
+std::vector<std::pair<std::string, double>> named_state(const ExplicitForm& form, const std::map<std::string, std::vector<double>>& initial);
+
 // A record made ready to be simulated (validate() and output-error refinement, runtime/refine/):
 // the grid from the first sample where every state derivative has its centred moving-arc
 // estimate (to ValidationOptions::max_samples), the record's inputs and initial values, the

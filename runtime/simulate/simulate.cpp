@@ -237,9 +237,11 @@ class System {
   // The modes of the step starting at (t, state): each switching function's sign there (kLiveMode
   // where it is 0: the step itself decides), used by every stage until the next freeze or thaw.
   void freeze(double t, const double* state) {
-    frozen_ = false;
-    std::vector<double> g;
-    switching_values(t, state, g);
+    switching_values(t, state, frozen_values_);
+    freeze(frozen_values_);
+  }
+  // The same from the switching functions' values there, when the caller has them.
+  void freeze(const std::vector<double>& g) {
     modes_.resize(g.size());
     for (std::size_t i = 0; i < g.size(); ++i) modes_[i] = g[i] > 0 ? 1 : g[i] < 0 ? -1 : kLiveMode;
     frozen_ = true;
@@ -453,6 +455,7 @@ class System {
   std::vector<double> g_, c_;  // the sensitivity equations' d(A z + r)/dx (k x n) and right-hand side (k x Q), row-major
   std::vector<PointSum> switching_;
   std::vector<signed char> modes_;  // frozen modes of the current step (freeze())
+  std::vector<double> frozen_values_;  // freeze()'s switching values, kept to spare an allocation per step
   bool frozen_ = false;
   std::vector<std::vector<PointSum>> switching_partial_;  // [function][state component], with sensitivities
   std::vector<Source> sources_;
@@ -591,10 +594,12 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
         int located = 0;
         while (t < end) {
           double step = end - t;
-          if (locate) system.freeze(t, s.data());  // every stage of this step in the modes it starts in
+          if (locate) {  // every stage of this step in the modes it starts in
+            system.switching_values(t, s.data(), g0);
+            system.freeze(g0);
+          }
           bool ok = rk4_step(system, t, s, step, next, k, tmp);
           if (ok && locate && located < 16) {
-            system.switching_values(t, s.data(), g0);
             system.switching_values(t + step, next.data(), g1);
             if (any_sign_change(g0, g1)) {
               // Bisection on the step length: the shortest step after which a guard has switched.

@@ -67,6 +67,15 @@ std::string summary(const ir::Model& m, const std::string& path) {
     if (n > 0) out += fmt::format("# equation {} integrated {} time{} from t0 to t\n", i + 1, n, n == 1 ? "" : "s");
   }
   if (!constants.empty()) out += "# integration constants: " + constants + "\n";
+  std::string units, unitless;
+  for (const auto& p : m.parameters) {
+    if (p.unit) units += fmt::format("{}{} [{}]", units.empty() ? "" : ", ", p.name, to_string(*p.unit));
+    else unitless += (unitless.empty() ? "" : ", ") + p.name;
+  }
+  if (!units.empty()) {
+    out += "# parameter units (from the signals'): " + units + "\n";
+    if (!unitless.empty()) out += "# no unit (a signal of its term, or its equation's known side, has none): " + unitless + "\n";
+  }
   if (m.form_from_data)
     out += "# no form named: `sidc fit` chooses weak, derivative or integrated from the data (`set form` names one); printed: the derivative form\n";
   return out;
@@ -114,7 +123,7 @@ int run_compile(const CompileArguments& a) {
     if (r.last_pass == "parse") std::cout << print_ast(r.parsed.model);
     else if (r.last_pass == "declare") std::cout << "# declarations checked; nothing is rewritten before `lower`\n";
     else if (r.last_pass == "lower") std::cout << r.lowered_text;
-    else if (r.last_pass == "normalize") std::cout << print(*r.normalized);
+    else if (r.last_pass == "normalize" || r.last_pass == "units") std::cout << print(*r.normalized);
     else std::cout << print(*r.integrated);
     return exit_code::success;
   }
@@ -151,7 +160,7 @@ void add_compile_command(CLI::App& app, int& exit_status) {
       ->check(CLI::IsMember({"derivative", "integrated", "weak"}))
       ->excludes(integrate);
   auto* dump = cmd->add_option("--dump", args->dump, "Print one stage instead of compiling: ast, normalized or integrated");
-  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, integrate, weak, hold)")
+  cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, units, integrate, weak, hold)")
       ->excludes(dump);
   cmd->callback([args, &exit_status] { exit_status = run_compile(*args); });
 }

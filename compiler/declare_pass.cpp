@@ -61,6 +61,15 @@ struct Declarer {
       s.name = item.name.name;
       s.kind = d.kind == "input" ? ir::Signal::Kind::input : ir::Signal::Kind::output;
       s.span = where;
+      if (item.unit) {
+        ir::UnitParseError error;
+        s.unit = ir::parse_unit(item.unit->text, &error);
+        if (!s.unit) {
+          const std::size_t at = item.unit->offset + error.offset;
+          diagnostics.add(diag::bad_unit(Span{where.file, at, at + 1}, s.name, error.message));
+          continue;
+        }
+      }
       if (item.hold) {
         const Span hold_at = span(*item.hold);
         const auto hold = ir::hold_from(item.hold->name);
@@ -107,9 +116,9 @@ struct Declarer {
         }
         out.families[item.name.name] = {from, to};
         for (int k = from; k <= to; ++k)
-          out.model.parameters.push_back({fmt::format("{}[{}]", item.name.name, k), ir::Parameter::Origin::declared, where, -1});
+          out.model.parameters.push_back({fmt::format("{}[{}]", item.name.name, k), ir::Parameter::Origin::declared, where, -1, std::nullopt});
       } else {
-        out.model.parameters.push_back({item.name.name, ir::Parameter::Origin::declared, where, -1});
+        out.model.parameters.push_back({item.name.name, ir::Parameter::Origin::declared, where, -1, std::nullopt});
       }
     }
   }

@@ -114,7 +114,7 @@ struct Lowerer {
       return {};
     }
     if (index < 0) {  // implicit: no `param` declaration in the file
-      decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1});
+      decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1, std::nullopt});
       index = static_cast<int>(decl.model.parameters.size()) - 1;
     }
     return ir::factor(make(FactorKind::parameter, name, index), 1, where);

@@ -375,6 +375,51 @@ Diagnostic unknown_hold(const Span& where, std::string_view signal, std::string_
                "`smooth` (the default); separate several signals with commas: `input x, u`");
 }
 
+Diagnostic bad_unit(const Span& where, std::string_view signal, std::string_view expected) {
+  return error("bad-unit", where, fmt::format("the unit of `{}` does not read: {}", signal, expected),
+               "write a product of unit symbols with whole or parenthesised exponents, e.g. `[m]`, `[N*m]`, `[m/s^2]`, "
+               "`[kg*m^(1/2)]`, or `[1]` for a dimensionless signal (docs/language.md, \"Units\")");
+}
+
+namespace {
+// " (line N)" for a second place on another line than the first.
+std::string at_line(const Span& s, const Span& where) {
+  return s.known() && (!where.known() || s.start().line != where.start().line) ? fmt::format(" (line {})", s.start().line) : std::string();
+}
+}  // namespace
+
+Diagnostic unit_mismatch(const Span& where, std::string_view unit, std::string_view expected_unit, const Span& expected_at) {
+  return error("unit-mismatch", where,
+               fmt::format("this term has the unit {}, but the terms it is added to have {}{}", unit, expected_unit,
+                           at_line(expected_at, where)),
+               "terms without a parameter must agree in unit, as nothing can absorb the difference: check the "
+               "signals' declared units, or give the term a parameter to estimate");
+}
+
+Diagnostic operation_unit_mismatch(const Span& where, std::string_view parameter, std::string_view unit,
+                                   std::string_view other_unit, const Span& other_at) {
+  return error("operation-unit-mismatch", where,
+               fmt::format("this term multiplies `{}` with the unit {}, another of its terms{} has {}", parameter, unit,
+                           at_line(other_at, where), other_unit),
+               fmt::format("`{}` can have one unit only: give the terms separate parameters, or check the signals' "
+                           "declared units",
+                           parameter));
+}
+
+Diagnostic function_of_unit(const Span& where, std::string_view function, std::string_view unit) {
+  return error("function-of-unit", where,
+               fmt::format("the argument of `{}` has the unit {}; `{}` takes a dimensionless one", function, unit, function),
+               "divide by a quantity of the same unit, declare the signal in radians (`[rad]`, dimensionless), or "
+               "write a number factor, which carries the unit (`sin(2*pi*t)` reads as 2*pi rad/s times t)");
+}
+
+Diagnostic parameter_unit_conflict(const Span& where, std::string_view parameter, std::string_view unit,
+                                   std::string_view other_unit, const Span& other_at) {
+  return error("parameter-unit-conflict", where,
+               fmt::format("`{}` needs the unit {} here and {} in the equation{}", parameter, unit, other_unit, at_line(other_at, where)),
+               "a parameter has one unit: use two parameters, or check the signals' declared units");
+}
+
 Diagnostic hold_on_output(const Span& where, std::string_view signal, std::string_view word) {
   return error("hold-on-output", where, fmt::format("the output `{}` cannot be `{}`", signal, word),
                "a hold says how an input was applied between samples; outputs are smooth responses, estimated by "

@@ -130,6 +130,16 @@ Diagnostic hold_on_output(const Span& where, std::string_view signal, std::strin
 Diagnostic hold_on_defined_input(const Span& where, std::string_view signal, std::string_view word);
 Diagnostic derivative_of_held_input(const Span& where, std::string_view signal, std::string_view hold, std::string_view written);
 Diagnostic static_model_integrated(const Span& where, int times);
+// Units (`output theta [rad]`, compiler/unit_pass.cpp): a unit that does not read, a term whose
+// unit cannot match its equation, a function of a quantity with a unit, one parameter needing two
+// units.
+Diagnostic bad_unit(const Span& where, std::string_view signal, std::string_view expected);
+Diagnostic unit_mismatch(const Span& where, std::string_view unit, std::string_view expected_unit, const Span& expected_at);
+Diagnostic operation_unit_mismatch(const Span& where, std::string_view parameter, std::string_view unit,
+                                   std::string_view other_unit, const Span& other_at);
+Diagnostic function_of_unit(const Span& where, std::string_view function, std::string_view unit);
+Diagnostic parameter_unit_conflict(const Span& where, std::string_view parameter, std::string_view unit,
+                                   std::string_view other_unit, const Span& other_at);
 Diagnostic unknown_pass(std::string_view name, std::string_view nearest, std::string_view passes);
 Diagnostic integrate_option_invalid(std::string_view value);
 Diagnostic no_signal(const Span& where);

@@ -109,11 +109,20 @@ struct ModelName : x3::position_tagged {
   Identifier name;
 };
 
-// One signal of an `input`/`output` declaration; an input may be given as an expression of t
-// (`input x = 60*sin(4*pi*t)`, as the thesis evaluated its excitation) or carry how it was held
-// between samples (`input x held`; the word is checked by compiler/declare_pass.cpp).
+// `[N*m]` after a signal's name: its unit, kept as text and read by compiler/declare_pass.cpp
+// (ir/units.hpp), which reports a bad unit at its own column.
+struct UnitText : x3::position_tagged {
+  std::string text;
+  std::size_t offset = 0;  // byte offset of the text in the source
+};
+
+// One signal of an `input`/`output` declaration, with its unit if given (`output theta [rad]`); an
+// input may be given as an expression of t (`input x = 60*sin(4*pi*t)`, as the thesis evaluated
+// its excitation) or carry how it was held between samples (`input x held`; the word is checked
+// by compiler/declare_pass.cpp).
 struct SignalItem : x3::position_tagged {
   Identifier name;
+  std::optional<UnitText> unit;
   std::optional<Identifier> hold;
   std::optional<Expression> definition;
 };

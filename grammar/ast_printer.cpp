@@ -65,6 +65,7 @@ struct AstPrinter {
     out += "(" + d.kind;
     for (const auto& s : d.signals) {
       out += " " + s.name.name;
+      if (s.unit) out += " [" + s.unit->text + "]";
       if (s.hold) out += " " + s.hold->name;
       if (s.definition) {
         out += " = ";

@@ -150,6 +150,8 @@ x3::rule<struct signal_name_class, ast::Identifier> const signal_name = expected
 x3::rule<struct signal_item_class, ast::SignalItem> const signal_item = expected::signal_name;
 x3::rule<struct signal_items_class, std::vector<ast::SignalItem>> const signal_items = expected::signal_name;
 x3::rule<struct signal_declaration_class, ast::SignalDeclaration> const signal_declaration = "a signal declaration";
+x3::rule<struct unit_text_class, ast::UnitText> const unit_text = "a unit";
+x3::rule<struct unit_text_assembled_class, ast::UnitText> const unit_text_assembled = "a unit";
 x3::rule<struct parameter_name_class, ast::Identifier> const parameter_name = expected::parameter_name;
 x3::rule<struct family_range_class, std::pair<int, int>> const family_range = "a range such as `[1..6]`";
 x3::rule<struct parameter_item_class, ast::ParameterItem> const parameter_item = expected::parameter_name;
@@ -254,6 +256,14 @@ auto const assign_setting = [](auto& ctx) {
   result.value_offset = x3::get<x3::error_handler_tag>(ctx).get().offset(value.begin());
 };
 
+// The unit's text between the brackets, and where it starts (for a caret inside it).
+auto const assign_unit_text = [](auto& ctx) {
+  auto const& text = x3::_attr(ctx);
+  ast::UnitText& result = x3::_val(ctx);
+  result.text.assign(text.begin(), text.end());
+  result.offset = x3::get<x3::error_handler_tag>(ctx).get().offset(text.begin());
+};
+
 auto const assign_weights = [](auto& ctx) { x3::_val(ctx).value = std::move(x3::_attr(ctx)); };
 
 // ---- lexical rules -------------------------------------------------------------------------------
@@ -326,7 +336,9 @@ auto const signal_kind_def = raw[lexeme[(lit("input") | lit("output")) >> !name_
 auto const signal_name_def = identifier;
 // `input x = 60*sin(4*pi*t)`: an input given as an expression of t; `input x held`: how a recorded
 // input was held between its samples.
-auto const signal_item_def = signal_name >> -identifier >> -(lit('=') > expression);
+// `output theta [rad]`: the unit, read by the compiler (ir/units.hpp).
+auto const unit_text_assembled_def = (lit('[') > raw[lexeme[*(char_ - ']')]] > closing_bracket)[assign_unit_text];
+auto const signal_item_def = signal_name >> -unit_text >> -identifier >> -(lit('=') > expression);
 auto const signal_items_def = signal_item >> *(lit(',') > signal_item);
 auto const signal_declaration_def = signal_kind > signal_items;
 
@@ -392,6 +404,7 @@ auto const parameter_declaration_def = parameter_declaration_assembled;
 auto const constant_declaration_def = constant_declaration_assembled;
 auto const setting_def = setting_assembled;
 auto const weights_setting_def = weights_setting_assembled;
+auto const unit_text_def = unit_text_assembled;
 
 // (Boost.Preprocessor takes at most 64 arguments per macro call.)
 BOOST_SPIRIT_DEFINE(identifier, number, string_literal, closing_quote, closing_parenthesis, closing_bracket, integer,
@@ -404,14 +417,14 @@ BOOST_SPIRIT_DEFINE(expression, additive_operand, additive_expression, additive_
 BOOST_SPIRIT_DEFINE(identifier_assembled, number_assembled, builtin_callee_assembled, guard_assembled,
                     expression_assembled, model_statement_assembled, parameter_item_assembled,
                     parameter_declaration_assembled, constant_declaration_assembled, setting_assembled,
-                    weights_setting_assembled)
+                    weights_setting_assembled, unit_text_assembled)
 BOOST_SPIRIT_DEFINE(model_name, model_statement, signal_kind, signal_name, signal_item, signal_items,
                     signal_declaration, parameter_name, family_range, parameter_item, parameter_items,
                     parameter_declaration, constant_name, constant_equals, constant_item, constant_items,
                     constant_declaration, file_name, binding_signal, binding_equals, column_name, column_binding,
                     column_bindings, data_statement, setting_name, setting_equals, setting_value, setting,
                     equation_equals, equation, statement, end_of_statement, statement_line)
-BOOST_SPIRIT_DEFINE(weights_value, weights_setting, plot_name, plot_parenthesis, plot_argument, plot_equals,
+BOOST_SPIRIT_DEFINE(unit_text, weights_value, weights_setting, plot_name, plot_parenthesis, plot_argument, plot_equals,
                     plot_statement)
 
 // ---- annotation and error handling -----------------------------------------------------------------
@@ -437,6 +450,7 @@ struct guard_class : x3::annotate_on_success {};
 struct sum_over_class : x3::annotate_on_success {};
 struct model_statement_class : x3::annotate_on_success {};
 struct signal_item_class : x3::annotate_on_success {};
+struct unit_text_class : x3::annotate_on_success {};
 struct signal_declaration_class : x3::annotate_on_success {};
 struct parameter_item_class : x3::annotate_on_success {};
 struct parameter_declaration_class : x3::annotate_on_success {};

@@ -314,12 +314,18 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
                    {"definition", s.definition ? sum_json(*s.definition) : ordered(nullptr)}, {"span", span_json(s.span)}};
     // Written only when not smooth, so that files of models without held inputs stay as they were.
     if (s.hold != ir::Signal::Hold::smooth) signal["hold"] = to_string(s.hold);
+    if (s.unit) signal["unit"] = to_string(*s.unit);  // likewise only when given
     signals.push_back(std::move(signal));
   }
   j["signals"] = std::move(signals);
   ordered parameters = ordered::array();
-  for (const auto& p : m.parameters)
-    parameters.push_back(ordered{{"name", p.name}, {"origin", origin_name(p.origin)}, {"equation", p.equation}, {"span", span_json(p.span)}});
+  for (const auto& p : m.parameters) {
+    ordered parameter{{"name", p.name}, {"origin", origin_name(p.origin)}, {"equation", p.equation}, {"span", span_json(p.span)}};
+    // Derived from the signals' units (compiler/unit_pass.cpp), for readers of the file; sidc
+    // derives them again when it reads the file.
+    if (p.unit) parameter["unit"] = to_string(*p.unit);
+    parameters.push_back(std::move(parameter));
+  }
   j["parameters"] = std::move(parameters);
   ordered constants = ordered::object();
   for (const auto& [name, value] : m.constants) constants[name] = number_json(value);
@@ -372,6 +378,10 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
         if (sig.kind != ir::Signal::Kind::input || sig.definition)
           throw std::runtime_error("the signal `" + sig.name + "` has a hold but is not a recorded input");
       }
+      if (s.contains("unit")) {
+        sig.unit = ir::parse_unit(s.at("unit").get<std::string>());
+        if (!sig.unit) throw std::runtime_error("the unit of the signal `" + sig.name + "` does not read");
+      }
       m.signals.push_back(std::move(sig));
     }
     for (const auto& p : j.at("parameters")) {
@@ -380,7 +390,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
                               origin == "implicit" ? ir::Parameter::Origin::implicit
                               : origin == "integration_constant" ? ir::Parameter::Origin::integration_constant
                                                                   : ir::Parameter::Origin::declared,
-                              r.span(p.at("span")), p.at("equation").get<int>()});
+                              r.span(p.at("span")), p.at("equation").get<int>(), std::nullopt});
     }
     for (const auto& [name, value] : j.at("constants").items()) m.constants.emplace(name, r.number(value));
     for (const auto& [key, value] : j.at("settings").at("as_written").items()) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "ir/number.hpp"
+#include "ir/units.hpp"
 #include "diagnostics/source.hpp"
 
 namespace sidc::ir {
@@ -125,6 +126,7 @@ struct Signal {
   enum class Hold { smooth, held, linear };
   Hold hold = Hold::smooth;
   Span hold_span;
+  std::optional<Unit> unit;  // `output theta [rad]`; nullopt: none given
 };
 
 const char* to_string(Signal::Hold h);  // "smooth", "held", "linear"
@@ -136,6 +138,9 @@ struct Parameter {
   Origin origin = Origin::declared;
   Span span;
   int equation = -1;  // for integration constants: the equation that introduced it
+  // Derived by compiler/unit_pass.cpp from the signals' units; nullopt where some factor of its
+  // term, or its equation's parameter-free side, has none.
+  std::optional<Unit> unit;
 };
 
 // How an equation is to be integrated (integrate_pass.cpp).

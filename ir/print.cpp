@@ -173,8 +173,9 @@ std::string print(const ir::Model& m) {
     std::string names;
     for (const auto& s : m.signals) {
       if (s.kind != kind) continue;
-      names += (names.empty() ? "" : ", ") + s.name + (s.definition ? " = " + print(*s.definition) : "") +
-               (s.hold != ir::Signal::Hold::smooth ? std::string(" ") + to_string(s.hold) : "");
+      names += (names.empty() ? "" : ", ") + s.name + (s.unit ? " [" + to_string(*s.unit) + "]" : "") +
+               (s.hold != ir::Signal::Hold::smooth ? std::string(" ") + to_string(s.hold) : "") +
+               (s.definition ? " = " + print(*s.definition) : "");
     }
     if (!names.empty()) out += fmt::format("{} {}\n", keyword, names);
   };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <regex>
 
+#include "ir/units.hpp"
+
 namespace sidc {
 namespace {
 
@@ -27,7 +29,7 @@ std::optional<int> whole_number(const std::string& text) {
 const std::vector<std::string>& setting_keys() {
   static const std::vector<std::string> keys{"integrate", "form", "constants", "derivative", "second_derivative", "edges",
                                              "integration", "smooth_before_integration", "from", "to", "every", "step", "weights", "refine",
-                                             "estimator"};
+                                             "estimator", "time_unit"};
   return keys;
 }
 
@@ -86,6 +88,11 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
     if (value != "least_squares" && value != "iv")
       r.expected = "`least_squares` (equation error, thesis section 2-1; the default) or `iv` (refined instrumental variables: "
                    "instruments from the fitted equations solved without noise)";
+  } else if (key == "time_unit") {
+    ir::UnitParseError error;
+    if (!ir::parse_unit(value, &error))
+      r.expected = "a unit of time such as `s`, `min` or `ms` (" + error.message + " at character " +
+                   std::to_string(error.offset + 1) + ")";
   } else if (key == "step") {
     if (!positive_number(value)) r.expected = "a positive sampling step, e.g. `0.01`";
   } else {

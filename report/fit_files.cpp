@@ -69,8 +69,12 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
       if (r < g.subdomains.size()) records.back()["weak_subdomains"] = g.subdomains[r];
     }
     ordered_json parameters = ordered_json::array();
-    for (const auto& p : ls.parameters)
+    for (const auto& p : ls.parameters) {
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}}});
+      // Only for models that give units (docs/language.md, "Units"): other files stay as they were.
+      if (const int k = m.parameter_index(p.name); k >= 0 && m.parameters[static_cast<std::size_t>(k)].unit)
+        parameters.back()["unit"] = to_string(*m.parameters[static_cast<std::size_t>(k)].unit);
+    }
     ordered_json regions = ordered_json::array();
     for (const auto& r : g.regions) regions.push_back({{"guards", r.guards}, {"rows", r.rows}});
     ordered_json dependent = ordered_json::array();

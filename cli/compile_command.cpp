@@ -82,6 +82,8 @@ std::string summary(const ir::Model& m, const std::string& path) {
 }
 
 int run_compile(const CompileArguments& a) {
+  if (const auto input = input_overwritten_by(a.output, {a.model}); !input.empty())
+    return fail(render(cli_diag::output_is_input(a.output, input)), exit_code::usage_error);
   auto text = read_text_file(a.model);
   if (auto* d = std::get_if<Diagnostic>(&text)) {
     std::cerr << render(cli_diag::model_not_read(*d)) << "\n";

@@ -19,6 +19,7 @@
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/queries.hpp"
 #include "ir/settings.hpp"
+#include "report/atomic_file.hpp"
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
@@ -74,6 +75,15 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   if (!options) return fail(error, exit_code::usage_error);
   auto loaded = load_records(*compiled, compiled_path, a.records, error);
   if (!loaded) return fail(error, exit_code::user_error);
+  {  // Before any work: no output may overwrite the model, its source or a record.
+    std::vector<std::string> inputs{compiled_path, (fs::path(compiled_path).parent_path() / fs::path(compiled->source->name).filename()).string()};
+    for (const auto& s : loaded->sources) inputs.push_back(s.path);
+    std::vector<std::string> outputs = out_dir.empty() ? std::vector<std::string>{} : fit_file_paths(out_dir);
+    outputs.push_back(a.report);
+    for (const auto& output : outputs)
+      if (const auto input = input_overwritten_by(output, inputs); !input.empty())
+        return fail(render(cli_diag::output_is_input(output, input)), exit_code::usage_error);
+  }
   const std::vector<SampledRecord>& records = loaded->records;
   std::string form_report;
   std::optional<FormChoice> choice;

@@ -19,6 +19,7 @@
 #include "compiler/load_model.hpp"
 #include "compiler/pipeline.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "report/atomic_file.hpp"
 #include "report/fit_files.hpp"
 #include "runtime/select/select.hpp"
 #include "runtime/simulate/validate.hpp"
@@ -115,6 +116,12 @@ int run_select(const SelectArguments& a) {
 
   auto loaded = load_records(*compiled, a.model, a.records, error);
   if (!loaded) return fail(error, exit_code::user_error);
+  if (!a.out.empty()) {  // before any work: select.json may not overwrite the model or a record
+    std::vector<std::string> inputs{a.model};
+    for (const auto& s : loaded->sources) inputs.push_back(s.path);
+    if (const auto input = input_overwritten_by(select_file_path(a.out), inputs); !input.empty())
+      return usage(cli_diag::output_is_input(select_file_path(a.out), input));
+  }
   const std::vector<SampledRecord>& records = loaded->records;
 
   // Section 2-4's test as a criterion: each size's best subset, solved from the record like the

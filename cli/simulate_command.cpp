@@ -183,6 +183,8 @@ int run_simulate(const SimulateArguments& a) {
   if (!a.data.empty()) source.path = a.data;
   else if (!model.data.empty() && fs::path(source.path).is_relative())
     source.path = (fs::path(a.model).parent_path() / source.path).lexically_normal().string();
+  if (const auto input = input_overwritten_by(a.out, {a.model, source.path, a.params_file}); !input.empty())
+    return fail(render(cli_diag::output_is_input(a.out, input)), exit_code::usage_error);
   if (!source.path.empty()) {
     if (a.step) return fail(render(cli_diag::step_with_record()), exit_code::usage_error);
     auto read = read_csv(source.path);
@@ -218,8 +220,11 @@ int run_simulate(const SimulateArguments& a) {
       return fail(render(cli_diag::grid_needs_end_and_step()), exit_code::usage_error);
     const double t0 = a.t0.value_or(0.0);
     if (!(*a.t1 > t0)) return fail(render(cli_diag::end_not_after_t0(*a.t1, t0)), exit_code::usage_error);
-    const auto count = static_cast<std::size_t>(std::floor((*a.t1 - t0) / *a.step + 1e-9));
-    if (count > 10'000'000) return fail(render(cli_diag::too_many_output_rows(count, *a.step, t0, *a.t1)), exit_code::usage_error);
+    // Compared as a double, before it becomes an integer: a step of 1e-300 gives more rows than any
+    // integer type holds (the conversion would be undefined).
+    const double rows = std::floor((*a.t1 - t0) / *a.step + 1e-9);
+    if (!(rows <= 10'000'000.0)) return fail(render(cli_diag::too_many_output_rows(rows, *a.step, t0, *a.t1)), exit_code::usage_error);
+    const auto count = static_cast<std::size_t>(rows);
     for (std::size_t i = 0; i <= count; ++i) o.time.push_back(t0 + static_cast<double>(i) * *a.step);
     for (const auto& s : model.signals)
       if (s.kind == ir::Signal::Kind::input && !s.definition)

@@ -33,6 +33,21 @@ Diagnostic cannot_create_directory(std::string_view path, std::string_view reaso
   return message("cannot-create-directory", fmt::format("cannot create `{}`: {}", path, reason), std::string(hint));
 }
 
+Diagnostic output_is_input(std::string_view output, std::string_view input) {
+  return message("output-is-input", fmt::format("output `{}` is `{}`, an input of this run: writing it would destroy it", output, input),
+                 "choose another output path");
+}
+
+Diagnostic not_a_regular_file(std::string_view path, std::string_view what) {
+  return message("not-a-regular-file", fmt::format("cannot read `{}`: it is {}, not a regular file", path, what),
+                 "sidc reads model and parameter files whole; save the text to a file first");
+}
+
+Diagnostic cannot_write_stdout(std::string_view reason) {
+  return message("cannot-write-stdout", fmt::format("cannot write standard output: {}", reason),
+                 "the output is incomplete; free space on the disk it goes to, or read it whole (not through `head`)");
+}
+
 Diagnostic not_a_compiled_model(std::string_view path) { return message("not-a-compiled-model", fmt::format("`{}` is not a compiled sidc model", path)); }
 
 Diagnostic compiled_model_version(std::string_view path, int found, int expected) {
@@ -197,8 +212,10 @@ Diagnostic grid_needs_end_and_step() {
                  "e.g. `--t1 1 --step 0.01`, or give a record with `--data`");
 }
 
-Diagnostic too_many_output_rows(std::size_t count, double step, double t0, double t1) {
-  return message("too-many-output-rows", fmt::format("{} steps of {} from {} to {} is more than 10^7 output rows", count, step, t0, t1),
+Diagnostic too_many_output_rows(double count, double step, double t0, double t1) {
+  // Whole counts as integers; those past 2^53 (a step of 1e-300) with an exponent.
+  const std::string steps = count < 9e15 ? fmt::format("{}", static_cast<long long>(count)) : fmt::format("{:.3g}", count);
+  return message("too-many-output-rows", fmt::format("{} steps of {} from {} to {} is more than 10^7 output rows", steps, step, t0, t1),
                  "use a larger `--step`");
 }
 

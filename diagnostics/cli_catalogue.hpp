@@ -21,6 +21,12 @@ Diagnostic model_not_read(const Diagnostic& why);
 // `why` as given by report/atomic_file.hpp ("cannot write `FILE`: REASON").
 Diagnostic cannot_write(std::string_view why, std::string_view hint = {});
 Diagnostic cannot_create_directory(std::string_view path, std::string_view reason, std::string_view hint = {});
+// An output path that names one of the run's inputs (the model, a record, a compiled model).
+Diagnostic output_is_input(std::string_view output, std::string_view input);
+// A model or parameter file that is not a regular file (a FIFO, a device); `what`: "a FIFO", ...
+Diagnostic not_a_regular_file(std::string_view path, std::string_view what);
+// Writing to standard output failed (a full disk, a closed pipe).
+Diagnostic cannot_write_stdout(std::string_view reason);
 Diagnostic not_a_compiled_model(std::string_view path);
 Diagnostic compiled_model_version(std::string_view path, int found, int expected);
 Diagnostic invalid_compiled_model(std::string_view path, std::string_view what);
@@ -70,7 +76,8 @@ Diagnostic step_with_record();
 Diagnostic every_without_record();
 Diagnostic too_few_samples_between(std::string_view record, double from, double to, double first, double last);
 Diagnostic grid_needs_end_and_step();
-Diagnostic too_many_output_rows(std::size_t count, double step, double t0, double t1);
+// `count` as a double: it may be past any integer type (a step of 1e-300).
+Diagnostic too_many_output_rows(double count, double step, double t0, double t1);
 Diagnostic input_without_values(std::string_view input);
 Diagnostic simulation_stopped(std::string_view message);
 

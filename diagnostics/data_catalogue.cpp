@@ -62,6 +62,22 @@ Diagnostic is_directory(std::string_view path) {
   return d;
 }
 
+Diagnostic not_a_regular_file(std::string_view path, std::string_view what) {
+  Diagnostic d;
+  d.code = "data-not-a-regular-file";
+  d.message = fmt::format("data file `{}` is {}, not a regular file", shown_path(path), what);
+  d.hint = "sidc reads a record whole, sized from the file: save it to a file first (`cat SOURCE > record.csv`)";
+  return d;
+}
+
+Diagnostic changed_while_read(std::string_view path, std::string_view how) {
+  Diagnostic d;
+  d.code = "data-changed-while-read";
+  d.message = fmt::format("data file `{}` {}", shown_path(path), how);
+  d.hint = "another program is writing or truncating it: copy the record once it is complete, and fit the copy";
+  return d;
+}
+
 Diagnostic empty_file(std::string_view path) {
   return located("data-empty-file", path, 1, 1, "data file holds no data (it is empty, or only comments and blank lines)",
                  "a record needs a header line of column names and one row per sample");
@@ -200,6 +216,16 @@ Diagnostic invalid_resampling_step(double step) {
   d.code = "data-invalid-resampling-step";
   d.message = fmt::format("resampling step {} is not a positive number", step);
   d.hint = "give the step in the time column's units, such as --resample 0.01";
+  return d;
+}
+
+Diagnostic too_many_resampled_rows(std::string_view path, double step, double asked, std::size_t rows, std::size_t limit, double mean_step) {
+  Diagnostic d;
+  d.code = "data-too-many-resampled-rows";
+  d.message = fmt::format("resampling `{}` ({} rows) with step {} would make {:.3g} rows; at most {} are allowed (16 times the record's "
+                          "rows, or 1000000 if that is more)",
+                          shown_path(path), rows, step, asked, limit);
+  d.hint = fmt::format("choose a step near the record's own: its mean step is {}", mean_step);
   return d;
 }
 

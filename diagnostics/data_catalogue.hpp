@@ -31,6 +31,10 @@ enum class CellFault : unsigned char {
 // ---- the file as a whole (records.cpp) ---------------------------------------------------------
 Diagnostic cannot_open(std::string_view path, std::string_view reason);
 Diagnostic is_directory(std::string_view path);
+// A FIFO, a device or a socket named as a record; `what`: "a FIFO", "a character device", ...
+Diagnostic not_a_regular_file(std::string_view path, std::string_view what);
+// The record's length changed between its fstat and its read (a logger writing or rotating it).
+Diagnostic changed_while_read(std::string_view path, std::string_view how);
 Diagnostic empty_file(std::string_view path);
 Diagnostic binary_file(std::string_view path, int row, int column);
 Diagnostic no_data_rows(std::string_view path, int header_row);
@@ -60,6 +64,9 @@ Diagnostic time_goes_backwards(std::string_view path, int row, int column, std::
 Diagnostic time_step_not_uniform(std::string_view path, int row, int column, std::string_view name, double found,
                                  double expected, double relative_tolerance);
 Diagnostic invalid_resampling_step(double step);
+// A resampling step so small that the record would grow past its limit (runtime/records/sampling.hpp,
+// max_resampled_rows): `asked` rows (a double: it may exceed any integer) of a record of `rows`.
+Diagnostic too_many_resampled_rows(std::string_view path, double step, double asked, std::size_t rows, std::size_t limit, double mean_step);
 Diagnostic empty_time_window(std::string_view path, std::string_view name, double from, double to, double first,
                              double last);
 

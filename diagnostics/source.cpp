@@ -1,13 +1,9 @@
 #include "diagnostics/source.hpp"
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "diagnostics/cli_catalogue.hpp"
+#include "diagnostics/regular_file.hpp"
 
 namespace sidc {
 
@@ -35,13 +31,19 @@ std::string_view SourceFile::line_text(int line) const {
 }
 
 std::variant<std::string, Diagnostic> read_text_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return cli_diag::is_directory(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return cli_diag::cannot_read(path, std::strerror(errno));
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  return std::move(contents).str();
+  // Only a regular file, read whole (regular_file.hpp): a FIFO or /dev/zero is refused at once.
+  auto read = read_regular_file(path);
+  if (auto* refusal = std::get_if<FileRefusal>(&read)) {
+    switch (refusal->kind) {
+      case FileRefusal::Kind::directory: return cli_diag::is_directory(path);
+      case FileRefusal::Kind::not_regular: return cli_diag::not_a_regular_file(path, refusal->reason);
+      case FileRefusal::Kind::cannot_open:
+      case FileRefusal::Kind::changed:
+      case FileRefusal::Kind::no_memory: return cli_diag::cannot_read(path, refusal->reason);
+    }
+  }
+  const auto& bytes = std::get<FileBytes>(read);
+  return std::string(bytes.data.get(), bytes.size);
 }
 
 std::optional<std::string> read_whole_file(const std::string& path, std::string& error) {

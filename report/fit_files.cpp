@@ -229,13 +229,21 @@ nlohmann::ordered_json refinement_json(const RefineSummary& r) {
 
 }  // namespace
 
+std::vector<std::string> fit_file_paths(const std::string& directory) {
+  const fs::path d(directory);
+  return {(d / "fit.json").string(), (d / "residuals.csv").string(), (d / "validation.csv").string()};
+}
+
+std::string select_file_path(const std::string& directory) { return (fs::path(directory) / "select.json").string(); }
+
 std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& f) {
   std::error_code ec;
   fs::create_directories(directory, ec);
   if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
-  const std::string json_path = (fs::path(directory) / "fit.json").string();
-  const std::string csv_path = (fs::path(directory) / "residuals.csv").string();
-  const std::string validation_path = (fs::path(directory) / "validation.csv").string();
+  const auto paths = fit_file_paths(directory);
+  const std::string& json_path = paths[0];
+  const std::string& csv_path = paths[1];
+  const std::string& validation_path = paths[2];
   auto json = fit_json(f.summary, f.compiled, f.compiled_path, f.options);
   if (f.validation) json["validation"] = validation_json(*f.validation);
   json["residual_analysis"] = residual_json(f.residuals);
@@ -255,14 +263,15 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   std::string why;
   std::optional<Diagnostic> problem;  // why the residual rows could not be had
   const ir::Model& model = f.compiled.integrated;
-  if (!write_file_atomically(json_path, json.dump(1) + "\n", &why) ||
-      !write_file_atomically(csv_path, [&](std::ostream& out) { return write_residuals(out, model, f.records, f.options, f.summary, problem); }, &why) ||
-      (curves && !write_file_atomically(validation_path, validation_csv(*f.validation), &why))) {
-    // No half set of files: a fit.json without its residuals.csv would read as complete.
-    std::error_code ignored;
-    for (const auto& path : {json_path, csv_path, validation_path}) fs::remove(path, ignored);
+  // One set, renamed in together once every file is whole: a failure leaves the previous run's
+  // files as they were, and a validation.csv this run does not write is removed with the commit
+  // (it would read as this fit's).
+  AtomicFileSet set;
+  if (!set.add(json_path, json.dump(1) + "\n", &why) ||
+      !set.add(csv_path, [&](std::ostream& out) { return write_residuals(out, model, f.records, f.options, f.summary, problem); }, &why) ||
+      (curves && !set.add(validation_path, validation_csv(*f.validation), &why)) ||
+      !set.commit(&why, curves ? std::vector<std::string>{} : std::vector<std::string>{validation_path}))
     return problem ? *problem : cli_diag::cannot_write(why);
-  }
   std::vector<std::string> written{json_path, csv_path};
   if (curves) written.push_back(validation_path);
   return written;
@@ -319,7 +328,7 @@ std::variant<std::string, Diagnostic> write_select_file(const std::string& direc
   std::error_code ec;
   fs::create_directories(directory, ec);
   if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
-  const std::string path = (fs::path(directory) / "select.json").string();
+  const std::string path = select_file_path(directory);
   std::string why;
   if (!write_file_atomically(path, select_json(summary, model_path, options).dump(1) + "\n", &why)) return cli_diag::cannot_write(why);
   return path;

@@ -1,9 +1,10 @@
 // The files a fit and a selection write (`sidc fit --out DIR`, `sidc select --out DIR`): fit.json,
 // residuals.csv, validation.csv and select.json. Formats are documented in docs/cli.md.
 //
-// Relies on: report/atomic_file.hpp. Guarantees: each file appears whole or not at all, and a fit's
-// set appears whole or not at all: when one file cannot be written, those already written are
-// removed (a fit.json without its residuals.csv would read as complete). residuals.csv is written
+// Relies on: report/atomic_file.hpp (AtomicFileSet). Guarantees: each file appears whole or not at
+// all, and a fit's set appears whole or not at all: every file is written into its temporary
+// first and all are renamed in together, so a failed run leaves the previous run's files as they
+// were (a fit.json without its residuals.csv, or beside an older one, would read as complete). residuals.csv is written
 // as the rows come (a streamed fit evaluates them again block by block), never held in memory.
 #pragma once
 
@@ -51,10 +52,15 @@ struct FitFiles {
 };
 
 // Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating
-// DIR); the paths written, or the Diagnostic of the first failure (nothing of the set is left).
+// DIR); the paths written, or the Diagnostic of the first failure (the previous files untouched).
+// A validation.csv of an earlier run is removed when this run writes none.
 std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& files);
+// The paths write_fit_files may write in DIR (fit.json, residuals.csv, validation.csv).
+std::vector<std::string> fit_file_paths(const std::string& directory);
 
 nlohmann::ordered_json select_json(const SelectSummary& summary, const std::string& model_path, const SelectOptions& options);
+// DIR/select.json.
+std::string select_file_path(const std::string& directory);
 // Writes DIR/select.json (creating DIR): its path, or the Diagnostic.
 std::variant<std::string, Diagnostic> write_select_file(const std::string& directory, const SelectSummary& summary, const std::string& model_path,
                                                         const SelectOptions& options);

@@ -303,19 +303,18 @@ RenderSummary render_figure(const Figure& figure, const std::string& directory, 
   const std::filesystem::path base = std::filesystem::path(directory.empty() ? "." : directory) / figure.name;
   const std::string svg_final = base.string() + ".svg", png_final = base.string() + ".png";
 
-  // Temporary outputs and the script, all in the output directory; removed on every path out.
-  std::vector<std::string> temporaries;
+  // Temporary outputs and the script, all in the output directory, locked while gnuplot draws;
+  // each TemporaryFile removes its file on every path out that does not rename it into place.
+  TemporaryFile svg_file = options.svg ? create_temporary_beside(svg_final, &why) : TemporaryFile();
+  TemporaryFile png_file = options.png && !(options.svg && svg_file.empty()) ? create_temporary_beside(png_final, &why) : TemporaryFile();
+  TemporaryFile script_file = !(options.svg && svg_file.empty()) && !(options.png && png_file.empty()) ? create_temporary_beside(base.string() + ".gp", &why)
+                                                                                                       : TemporaryFile();
   auto cleanup = [&]() {
-    for (const auto& path : temporaries) std::remove(path.c_str());
+    svg_file.remove();
+    png_file.remove();
+    script_file.remove();
   };
-  auto temporary = [&](const std::string& beside) {
-    std::string path = create_temporary_beside(beside, &why);
-    if (!path.empty()) temporaries.push_back(path);
-    return path;
-  };
-  const std::string svg_temporary = options.svg ? temporary(svg_final) : "";
-  const std::string png_temporary = options.png ? temporary(png_final) : "";
-  const std::string script_path = temporary(base.string() + ".gp");
+  const std::string svg_temporary = svg_file.path(), png_temporary = png_file.path(), script_path = script_file.path();
   if ((options.svg && svg_temporary.empty()) || (options.png && png_temporary.empty()) || script_path.empty()) {
     cleanup();
     summary.status = Status::io_error;
@@ -330,7 +329,7 @@ RenderSummary render_figure(const Figure& figure, const std::string& directory, 
         decimated ? decimate_for_drawing(curve.x, curve.y, static_cast<std::size_t>(options.width)).size()
                   : curve.x.size();
   }
-  if (!write_file_atomically(script_path, script, &why)) {
+  if (!write_temporary(script_file, script, &why)) {
     cleanup();
     summary.status = Status::io_error;
     summary.message = why;
@@ -354,7 +353,17 @@ RenderSummary render_figure(const Figure& figure, const std::string& directory, 
   char* argv[] = {program.data(), nullptr};
   const auto start = std::chrono::steady_clock::now();
   pid_t pid = 0;
-  const int spawned = ::posix_spawn(&pid, program.c_str(), &actions, nullptr, argv, environ);
+  // sidc ignores SIGPIPE (cli/main.cpp: a closed stdout is reported, not a death); gnuplot gets the
+  // default back, as any program started from a shell has it.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t default_signals;
+  sigemptyset(&default_signals);
+  sigaddset(&default_signals, SIGPIPE);
+  posix_spawnattr_setsigdefault(&attributes, &default_signals);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
+  const int spawned = ::posix_spawn(&pid, program.c_str(), &actions, &attributes, argv, environ);
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&actions);
   ::close(pipe_fds[1]);
   if (spawned != 0) {
@@ -401,9 +410,9 @@ RenderSummary render_figure(const Figure& figure, const std::string& directory, 
       return summary;
     }
   }
-  std::remove(script_path.c_str());
+  script_file.remove();
   if (options.svg) {
-    if (!replace_file(svg_temporary, svg_final, &why)) {
+    if (!replace_file(svg_file, svg_final, &why)) {
       cleanup();
       summary.status = Status::io_error;
       summary.message = why;
@@ -412,7 +421,7 @@ RenderSummary render_figure(const Figure& figure, const std::string& directory, 
     summary.files.push_back(svg_final);
   }
   if (options.png) {
-    if (!replace_file(png_temporary, png_final, &why)) {
+    if (!replace_file(png_file, png_final, &why)) {
       cleanup();
       // Both or neither: an SVG without its PNG is half a figure.
       for (const auto& file : summary.files) std::remove(file.c_str());

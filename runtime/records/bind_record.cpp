@@ -1,5 +1,6 @@
 #include "runtime/records/bind_record.hpp"
 
+#include <cmath>
 #include <fmt/format.h>
 #include <map>
 
@@ -90,7 +91,14 @@ std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned
   }
 
   if (options.resample) {
-    if (!(*options.resample > 0)) return data_diag::invalid_resampling_step(*options.resample);
+    if (!(*options.resample > 0) || !std::isfinite(*options.resample)) return data_diag::invalid_resampling_step(*options.resample);
+    // Checked before anything is allocated, and before the count becomes an integer.
+    if (time.size() >= 2) {
+      const double asked = resampled_rows(time.front(), time.back(), *options.resample);
+      if (!(asked <= static_cast<double>(max_resampled_rows(time.size()))))
+        return data_diag::too_many_resampled_rows(record.path, *options.resample, asked, time.size(), max_resampled_rows(time.size()),
+                                                  (time.back() - time.front()) / static_cast<double>(time.size() - 1));
+    }
     ResampledSignals r = resample_linear(time, columns, *options.resample);
     time = std::move(r.time);
     columns = std::move(r.columns);

@@ -1,5 +1,6 @@
-// CSV reading: the whole file mapped (read, when it cannot be mapped), then one pass over the
-// bytes, on two threads for large files (the second half from a line start near the middle; see
+// CSV reading: the whole file read into one buffer sized from the file (never mapped: a file
+// truncated while mapped ends the process with SIGBUS; diagnostics/regular_file.hpp), then one
+// pass over the bytes, on two threads for large files (the second half from a line start near the middle; see
 // parse_rows_on_two_threads). The fast path per cell
 // reads the number straight off the buffer (read_simple_number, else std::from_chars; both stop
 // at the separator by themselves), so a cell costs one conversion and a comparison; everything
@@ -7,8 +8,7 @@
 // looks at the cell's text. Measured on a
 // 10^7-row, 4-column, 426 MB file (2-core VM, -O2): about 28 M values/s and 300 MB/s in CPU
 // time for read_csv, 34 M values/s for parse_csv on text already in memory (one thread; the
-// 10^7-row bench record's figures with two threads are in bench/README.md). A file truncated by
-// another process while it is mapped can end the process with SIGBUS.
+// 10^7-row bench record's figures with two threads are in bench/README.md).
 #include "runtime/records/records.hpp"
 
 #include <algorithm>
@@ -26,10 +26,9 @@
 #include <new>
 #include <system_error>
 #include <thread>
+#include <unordered_map>
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <unistd.h>
+#include "diagnostics/regular_file.hpp"
 
 namespace sidc {
 namespace {
@@ -544,12 +543,17 @@ std::variant<Record, Diagnostic> CsvParser::run() {
   record_.first_faults.resize(n);
   if (has_header) {
     record_.header_line = first_line_number;
+    // Each name looked up among those before it in a hash map (a header of 300,000 names, compared
+    // pair by pair, took over 20 s). The views point into record_.names, reserved so none moves.
+    record_.names.reserve(n);
+    std::unordered_map<std::string_view, std::size_t> seen;
+    seen.reserve(n);
     for (const auto& f : fields) {
       std::string name = f.text.empty() ? fmt::format("c{}", f.column) : f.text;
-      for (std::size_t k = 0; k < record_.names.size(); ++k)
-        if (record_.names[k] == name)
-          return data_diag::duplicate_column(path_, first_line_number, f.column, name, static_cast<int>(k) + 1);
+      if (const auto it = seen.find(name); it != seen.end())
+        return data_diag::duplicate_column(path_, first_line_number, f.column, name, static_cast<int>(it->second) + 1);
       record_.names.push_back(std::move(name));
+      seen.emplace(record_.names.back(), record_.names.size() - 1);
     }
     skip_line_end(p);
   } else {
@@ -624,57 +628,21 @@ std::variant<Record, Diagnostic> parse_csv(std::string_view text, const std::str
 }
 
 std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOptions& options) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || status.type() == std::filesystem::file_type::not_found) {
-    return data_diag::cannot_open(path, status.type() == std::filesystem::file_type::not_found
-                                            ? "no such file"
-                                            : ec.message());
-  }
-  if (status.type() == std::filesystem::file_type::directory) return data_diag::is_directory(path);
-
-  // A regular file is mapped, not read: the parser works on the page cache itself, with no copy
-  // and no fresh buffer to fault in (a tenth of the time of a 400 MB record).
-  if (status.type() == std::filesystem::file_type::regular) {
-    const auto size = std::filesystem::file_size(path, ec);
-    if (!ec && size > 0) {
-      const int fd = ::open(path.c_str(), O_RDONLY);
-      if (fd >= 0) {
-        void* mapped = ::mmap(nullptr, static_cast<std::size_t>(size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-        ::close(fd);
-        if (mapped != MAP_FAILED) {
-          ::madvise(mapped, static_cast<std::size_t>(size), MADV_SEQUENTIAL);
-          auto result = parse_csv(std::string_view(static_cast<const char*>(mapped), static_cast<std::size_t>(size)), path, options);
-          ::munmap(mapped, static_cast<std::size_t>(size));
-          return result;
-        }
-      }
+  // Read, not mapped (diagnostics/regular_file.hpp): a file truncated while it is read gives an
+  // error, never SIGBUS; a FIFO or a device (/dev/zero) is refused before a byte is read.
+  auto read = read_regular_file(path);
+  if (auto* refusal = std::get_if<FileRefusal>(&read)) {
+    switch (refusal->kind) {
+      case FileRefusal::Kind::directory: return data_diag::is_directory(path);
+      case FileRefusal::Kind::not_regular: return data_diag::not_a_regular_file(path, refusal->reason);
+      case FileRefusal::Kind::changed: return data_diag::changed_while_read(path, refusal->reason);
+      case FileRefusal::Kind::cannot_open:
+        return data_diag::cannot_open(path, refusal->reason == std::strerror(ENOENT) ? "no such file" : refusal->reason);
+      case FileRefusal::Kind::no_memory: return data_diag::cannot_open(path, refusal->reason);
     }
   }
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!file) return data_diag::cannot_open(path, std::generic_category().message(errno));
-  // One read of the whole file into an uninitialised buffer (zeroing 400 MB first costs a tenth of
-  // the parse); files whose size is not known in advance (pipes, /proc) are read in chunks.
-  const auto size = std::filesystem::file_size(path, ec);
-  std::size_t capacity = !ec && size > 0 ? static_cast<std::size_t>(size) : std::size_t{1} << 16;
-  std::unique_ptr<char[]> buffer(new (std::nothrow) char[capacity]);
-  if (!buffer) return data_diag::cannot_open(path, "not enough memory to hold it");
-  std::size_t used = 0;
-  for (;;) {
-    used += std::fread(buffer.get() + used, 1, capacity - used, file.get());
-    if (used < capacity) break;  // a short read is the end of the file (or an error, checked below)
-    // A full buffer: the file may be longer than its size said (or had no size); look one byte on.
-    const int next = std::fgetc(file.get());
-    if (next == EOF) break;
-    std::unique_ptr<char[]> bigger(new (std::nothrow) char[capacity * 2]);
-    if (!bigger) return data_diag::cannot_open(path, "not enough memory to hold it");
-    std::memcpy(bigger.get(), buffer.get(), used);
-    bigger[used++] = static_cast<char>(next);
-    buffer = std::move(bigger);
-    capacity *= 2;
-  }
-  if (std::ferror(file.get())) return data_diag::cannot_open(path, std::generic_category().message(errno));
-  return parse_csv(std::string_view(buffer.get(), used), path, options);
+  const auto& bytes = std::get<FileBytes>(read);
+  return parse_csv(std::string_view(bytes.data.get(), bytes.size), path, options);
 }
 
 std::variant<const std::vector<double>*, Diagnostic> complete_column(const Record& record, std::string_view name) {

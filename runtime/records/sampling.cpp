@@ -145,6 +145,12 @@ Record select_rows(const Record& record, IndexRange rows, std::size_t every) {
   return out;
 }
 
+double resampled_rows(double t0, double t_last, double step) { return std::floor((t_last - t0) / step + kTimeFuzzInSteps) + 1; }
+
+std::size_t max_resampled_rows(std::size_t rows) {
+  return rows > kResampledRowsFloor / kResampledRowsPerRow ? rows * kResampledRowsPerRow : kResampledRowsFloor;
+}
+
 ResampledSignals resample_linear(std::span<const double> time, const std::vector<std::vector<double>>& columns,
                                  double step) {
   ResampledSignals out;
@@ -155,7 +161,9 @@ ResampledSignals resample_linear(std::span<const double> time, const std::vector
     if (column.size() != time.size()) return out;
 
   const double t0 = time.front();
-  const auto count = static_cast<std::size_t>(std::floor((time.back() - t0) / step + kTimeFuzzInSteps)) + 1;
+  const double rows = resampled_rows(t0, time.back(), step);
+  if (!(rows <= static_cast<double>(max_resampled_rows(time.size())))) return out;  // also NaN, inf
+  const auto count = static_cast<std::size_t>(rows);
   out.time.resize(count);
   for (std::size_t k = 0; k < count; ++k) out.time[k] = t0 + static_cast<double>(k) * step;
   out.columns.assign(columns.size(), std::vector<double>(count));
@@ -194,6 +202,9 @@ std::variant<Record, Diagnostic> resample_linear(const Record& record, std::stri
       return std::get<Diagnostic>(std::move(d));
   }
   if (!(step > 0) || !std::isfinite(step)) return data_diag::invalid_resampling_step(step);
+  if (const double rows = resampled_rows(time.front(), time.back(), step); !(rows <= static_cast<double>(max_resampled_rows(time.size()))))
+    return data_diag::too_many_resampled_rows(record.path, step, rows, time.size(), max_resampled_rows(time.size()),
+                                              (time.back() - time.front()) / static_cast<double>(time.size() - 1));
   ResampledSignals signals = resample_linear(time, record.columns, step);
   Record out = same_file_as(record);
   // The time column is the grid itself, not an interpolation of it.

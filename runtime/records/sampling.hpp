@@ -72,15 +72,27 @@ struct ResampledSignals {
   std::vector<std::vector<double>> columns;  // each column linearly interpolated onto `time`
 };
 
+// The rows a resampling with `step` makes of a record from t0 to t_last, as a double: a step of
+// 1e-300 asks for more rows than any integer type holds, so it is compared before it is converted.
+double resampled_rows(double t0, double t_last, double step);
+// The most rows a resampling may make of a record of `rows` rows: 16 times as many, or 10^6 when
+// that is more (docs/cli.md, --resample). A step of 1e-9 s on a 2 s record would ask for 2*10^9
+// rows, 16 GB a column.
+inline constexpr std::size_t kResampledRowsPerRow = 16;
+inline constexpr std::size_t kResampledRowsFloor = 1'000'000;
+std::size_t max_resampled_rows(std::size_t rows);
+
 // Linear interpolation of `columns` (each of time.size()) onto a uniform grid starting at
-// time[0]. Requires strictly increasing, finite time and step > 0; returns empty signals otherwise.
+// time[0]. Requires strictly increasing, finite time, step > 0 and at most max_resampled_rows
+// rows; returns empty signals otherwise.
 ResampledSignals resample_linear(std::span<const double> time, const std::vector<std::vector<double>>& columns,
                                  double step);
 
 // The whole record resampled on its time column (which must increase strictly); the time
 // column becomes the uniform grid. A faulty cell spreads to the new rows next to it, and the
 // diagnostic for them names the faulty cell's line; check the used columns before resampling to
-// report faults in the file's own terms.
+// report faults in the file's own terms. A step making more than max_resampled_rows rows is an
+// error.
 std::variant<Record, Diagnostic> resample_linear(const Record& record, std::string_view time_column, double step);
 
 }  // namespace sidc

@@ -1,12 +1,22 @@
 // report/atomic_file: every file sidc writes appears whole or not at all, beside no stray
-// temporary, with the mode a newly created file gets, and the old file intact on failure.
+// temporary, with the mode a newly created file gets, and the old file intact on failure; devices
+// and FIFOs are written through, never replaced; a link's target is replaced, not the link; a set
+// of files appears together; leftovers of killed runs are removed, live temporaries are not.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
 
 #include "report/atomic_file.hpp"
 
@@ -85,6 +95,122 @@ TEST_F(AtomicFile, TheFileGetsTheModeOfANewlyCreatedFile) {
   struct stat st {};
   ASSERT_EQ(::stat((dir / "m.txt").c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0644u);  // 0666 less the umask 022, not mkstemp's private 0600
+}
+
+
+TEST_F(AtomicFile, ACharacterDeviceIsWrittenThroughNotReplaced) {
+  if (::geteuid() != 0) GTEST_SKIP() << "making a device node needs root";
+  const fs::path device = dir / "null";
+  ASSERT_EQ(::mknod(device.c_str(), S_IFCHR | 0666, ::makedev(1, 3)), 0) << std::strerror(errno);  // as /dev/null
+  std::string why;
+  ASSERT_TRUE(write_file_atomically(device.string(), std::string("{}\n"), &why)) << why;
+  struct stat st {};
+  ASSERT_EQ(::lstat(device.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "the device was replaced by a regular file";
+  EXPECT_EQ(entries(), 1u);  // no temporary beside it
+  EXPECT_TRUE(is_written_through("/dev/null"));
+  EXPECT_TRUE(is_written_through("/dev/stdout"));
+  EXPECT_FALSE(is_written_through((dir / "new.json").string()));
+}
+
+TEST_F(AtomicFile, AFullDeviceIsAWriteErrorNamingIt) {
+  std::string why;
+  EXPECT_FALSE(write_file_atomically("/dev/full", std::string(100000, 'x'), &why));
+  EXPECT_NE(why.find("cannot write `/dev/full`: No space left on device"), std::string::npos) << why;
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/full", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+}
+
+TEST_F(AtomicFile, AFifoIsWrittenThroughToItsReader) {
+  const fs::path fifo = dir / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string received;
+  std::thread reader([&] { received = read(fifo); });
+  std::string why;
+  const bool written = write_file_atomically(fifo.string(), std::string("through the pipe\n"), &why);
+  reader.join();
+  EXPECT_TRUE(written) << why;
+  EXPECT_EQ(received, "through the pipe\n");
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(entries(), 1u);
+}
+
+TEST_F(AtomicFile, ALinksTargetIsReplacedAndTheLinkStays) {
+  fs::create_directories(dir / "real");
+  std::string why;
+  ASSERT_TRUE(write_file_atomically((dir / "real" / "m.json").string(), std::string("old"), &why)) << why;
+  fs::create_symlink("real/m.json", dir / "link.json");
+  ASSERT_TRUE(write_file_atomically((dir / "link.json").string(), std::string("new"), &why)) << why;
+  EXPECT_TRUE(fs::is_symlink(dir / "link.json"));
+  EXPECT_EQ(read(dir / "real" / "m.json"), "new");
+  EXPECT_EQ(entries(), 2u);  // the link and the folder: the temporary was made beside the target
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "real"), fs::directory_iterator()), 1);
+}
+
+TEST_F(AtomicFile, AFolderIsRefused) {
+  fs::create_directories(dir / "out.json");
+  std::string why;
+  EXPECT_FALSE(write_file_atomically((dir / "out.json").string(), std::string("x"), &why));
+  EXPECT_NE(why.find("Is a directory"), std::string::npos) << why;
+  EXPECT_TRUE(fs::is_directory(dir / "out.json"));
+}
+
+TEST_F(AtomicFile, LeftoversOfKilledRunsGoLiveTemporariesStay) {
+  std::ofstream(dir / ".fit.json.AbC123") << "killed run";
+  std::ofstream(dir / ".fit.json.XyZ789") << "live run";
+  std::ofstream(dir / ".other.json.AbC123") << "another name";
+  const int live = ::open((dir / ".fit.json.XyZ789").c_str(), O_RDONLY);
+  ASSERT_GE(live, 0);
+  ASSERT_EQ(::flock(live, LOCK_EX), 0);  // as the run writing it holds it
+  std::string why;
+  ASSERT_TRUE(write_file_atomically((dir / "fit.json").string(), std::string("{}"), &why)) << why;
+  EXPECT_FALSE(fs::exists(dir / ".fit.json.AbC123"));
+  EXPECT_TRUE(fs::exists(dir / ".fit.json.XyZ789"));
+  EXPECT_TRUE(fs::exists(dir / ".other.json.AbC123"));  // only this output's own leftovers
+  ::close(live);
+}
+
+TEST_F(AtomicFile, ASetAppearsTogetherOrLeavesThePreviousFiles) {
+  std::string why;
+  {
+    AtomicFileSet set;
+    ASSERT_TRUE(set.add((dir / "fit.json").string(), std::string("fit 1"), &why)) << why;
+    ASSERT_TRUE(set.add((dir / "validation.csv").string(), std::string("validation 1"), &why)) << why;
+    EXPECT_FALSE(fs::exists(dir / "fit.json"));  // nothing appears before the commit
+    ASSERT_TRUE(set.commit(&why)) << why;
+  }
+  {
+    AtomicFileSet set;
+    ASSERT_TRUE(set.add((dir / "fit.json").string(), std::string("fit 2"), &why)) << why;
+    EXPECT_FALSE(set.add((dir / "validation.csv").string(), [](std::ostream& out) {
+      out << "half";
+      return false;
+    }, &why));
+  }  // abandoned: the first file's temporary goes too
+  EXPECT_EQ(read(dir / "fit.json"), "fit 1");
+  EXPECT_EQ(read(dir / "validation.csv"), "validation 1");
+  EXPECT_EQ(entries(), 2u);
+  {
+    AtomicFileSet set;
+    ASSERT_TRUE(set.add((dir / "fit.json").string(), std::string("fit 3"), &why)) << why;
+    ASSERT_TRUE(set.commit(&why, {(dir / "validation.csv").string()})) << why;  // this run has none
+  }
+  EXPECT_EQ(read(dir / "fit.json"), "fit 3");
+  EXPECT_FALSE(fs::exists(dir / "validation.csv"));
+}
+
+TEST_F(AtomicFile, AnOutputThatIsAnInputIsFoundThroughLinks) {
+  std::ofstream(dir / "model.sid") << "model m";
+  fs::create_symlink("model.sid", dir / "alias.json");
+  const std::vector<std::string> inputs{(dir / "record.csv").string(), (dir / "model.sid").string()};
+  EXPECT_EQ(input_overwritten_by((dir / "alias.json").string(), inputs), (dir / "model.sid").string());
+  EXPECT_EQ(input_overwritten_by((dir / "." / "model.sid").string(), inputs), (dir / "model.sid").string());
+  EXPECT_EQ(input_overwritten_by((dir / "new.json").string(), inputs), "");  // does not exist yet
+  std::ofstream(dir / "other.json") << "x";
+  EXPECT_EQ(input_overwritten_by((dir / "other.json").string(), inputs), "");
 }
 
 }  // namespace

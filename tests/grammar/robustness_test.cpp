@@ -208,6 +208,19 @@ TEST(Robustness, ManyStatements) {
   EXPECT_TRUE(result.diagnostics.items.empty());
 }
 
+// The statement limit is exact, and a file of two million one-line equations (5.9 GB once built)
+// is refused at the first statement past it, without the rest being parsed.
+TEST(Robustness, StatementLimitIsExactAndChecked) {
+  const ParseResult at_limit = timed_parse("10 000 statements", repeated("y' = a\n", parser::statement_limit));
+  EXPECT_EQ(at_limit.model.statements.size(), parser::statement_limit);
+  EXPECT_TRUE(at_limit.diagnostics.items.empty());
+  const ParseResult millions = timed_parse("2 000 000 statements", repeated("y' = a\n", 2'000'000));
+  EXPECT_EQ(diagnostic_codes(millions), "too-many-statements");
+  EXPECT_EQ(millions.model.statements.size(), parser::statement_limit);
+  ASSERT_EQ(millions.diagnostics.items.size(), 1u);
+  EXPECT_EQ(millions.diagnostics.items[0].span.start().line, static_cast<int>(parser::statement_limit) + 1);
+}
+
 TEST(Robustness, MutatedModelsNeverThrowAndPointInsideTheText) {
   const std::string model =
       "model quasi_linear\ninput x = 60*sin(4*pi*t)\noutput y\nparam m, a[1..24]\nconst g = 9.81\n"

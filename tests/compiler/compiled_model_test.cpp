@@ -438,7 +438,7 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
          std::string text = R"({"text": "y", "terms": [{"coefficient": {"num": 1, "den": 1}, "span": null, "factors": [{"kind": "signal", "name": "y", "order": 0, "power": 1}]}]})";
          std::string open, close;
          for (int k = 0; k < 1000; ++k) {
-           open += R"({"text": "int(...)", "terms": [{"coefficient": {"num": 1, "den": 1}, "span": null, "factors": [{"kind": "integral", "power": 1, "argument": )";
+           open += R"J({"text": "int(...)", "terms": [{"coefficient": {"num": 1, "den": 1}, "span": null, "factors": [{"kind": "integral", "power": 1, "argument": )J";
            close += "}]}]}";
          }
          j["equations"][0]["operations"][0]["operation"] = json::parse(open + text + close);

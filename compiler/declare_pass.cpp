@@ -255,6 +255,18 @@ Declarations declare_pass(const ParseResult& parsed, Diagnostics& diagnostics) {
       }
     }
   }
+  // An empty fit window is the model's mistake, told at its `set` (command-line overrides are
+  // checked with the other options).
+  const auto& settings = d.out.model.settings.values;
+  if (auto from = settings.find("from"), to = settings.find("to"); from != settings.end() && to != settings.end()) {
+    const double a = Number::parse(from->second.text)->value(), b = Number::parse(to->second.text)->value();
+    if (a > b) {  // as FitOptions::is_valid: equal ends are judged with the record
+      const bool to_later = to->second.span.begin > from->second.span.begin;
+      const auto& later = to_later ? to->second : from->second;
+      const auto& earlier = to_later ? from->second : to->second;
+      diagnostics.add(diag::empty_fit_window_setting(later.span, from->second.text, to->second.text, earlier.span));
+    }
+  }
   return std::move(d.out);
 }
 

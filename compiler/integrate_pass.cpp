@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <unordered_set>
 #include <fmt/format.h>
 
 #include "ir/differentiate.hpp"
@@ -82,21 +83,37 @@ Sum at_window_start(const Sum& s) {
 }
 
 // Takes `t` off `remaining` (matched by factors and coefficient).
-bool take(std::vector<Term>& remaining, const Term& t) {
-  auto it = std::find_if(remaining.begin(), remaining.end(),
-                         [&](const Term& r) { return ir::compare_factors(r, t) == 0 && r.coefficient == t.coefficient; });
-  if (it == remaining.end()) return false;
-  remaining.erase(it);
-  return true;
+bool take(RemainingTerms& remaining, const Term& t) {
+  const auto at = remaining.find(t);
+  if (at) remaining.take(*at);
+  return at.has_value();
 }
 
 }  // namespace
+
+RemainingTerms::RemainingTerms(const ir::Sum& canonical_sum) : terms_(canonical_sum.terms), taken_(terms_.size(), false) {}
+
+void RemainingTerms::pop_front() { take(first_); }
+
+void RemainingTerms::take(std::size_t index) {
+  taken_[index] = true;
+  while (first_ < terms_.size() && taken_[first_]) ++first_;
+}
+
+std::optional<std::size_t> RemainingTerms::find(const ir::Term& t) const {
+  // A canonical sum is sorted by compare_factors, one term per product of factors.
+  const auto it = std::lower_bound(terms_.begin(), terms_.end(), t, [](const Term& a, const Term& b) { return ir::compare_factors(a, b) < 0; });
+  if (it == terms_.end() || ir::compare_factors(*it, t) != 0 || !(it->coefficient == t.coefficient)) return std::nullopt;
+  const auto index = static_cast<std::size_t>(it - terms_.begin());
+  if (taken_[index]) return std::nullopt;
+  return index;
+}
 
 // An exact antiderivative of `t` whose derivative consists of terms all present in `remaining`
 // (t among them); those terms are removed. Candidates lower one derivative of a signal by one
 // order: for y^2*y' the candidate y^3 has derivative 3*y^2*y', so y^3/3; for x'*y the candidate
 // x*y has derivative x'*y + x*y', accepted only if x*y' is there too.
-std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remaining, bool initial) {
+std::optional<Sum> exact_antiderivative(const Term& t, RemainingTerms& remaining, bool initial) {
   if (has_guard(t)) return std::nullopt;  // its antiderivative changes branch
   auto [constant, rest] = split_constant_part(t);
   // Powers of time alone: t^a -> t^(a+1)/(a+1), tau^b -> tau^(b+1)/(b+1), 1 -> tau.
@@ -137,9 +154,14 @@ std::optional<Sum> exact_antiderivative(const Term& t, std::vector<Term>& remain
     if (self == derivative->terms.end()) continue;
     const Number scale = t.coefficient / self->coefficient;
     const Sum expected = ir::scale(*derivative, scale);
-    std::vector<Term> trial = remaining;
-    if (!std::all_of(expected.terms.begin(), expected.terms.end(), [&](const Term& d) { return take(trial, d); })) continue;
-    remaining = std::move(trial);
+    std::vector<std::size_t> found;  // taken only when every term is there
+    for (const auto& d : expected.terms) {
+      const auto at = remaining.find(d);
+      if (!at) break;
+      found.push_back(*at);
+    }
+    if (found.size() != expected.terms.size()) continue;
+    for (std::size_t at : found) remaining.take(at);
     candidate.coefficient = scale;
     return ir::canonical(std::vector<Term>{candidate});
   }
@@ -152,11 +174,22 @@ struct Integrator {
   ir::Model& model;
   Diagnostics& diagnostics;
   int constants_made = 0;
+  // A trial integration (`auto`) only measures what derivatives remain: it makes no constants.
+  bool trial = false;
+  // The names in use, gathered once: looking each new constant up among 10 000 parameters made
+  // a model of as many equations quadratic.
+  std::unordered_set<std::string> names_taken;
 
   std::string next_constant_name() {
+    if (names_taken.empty()) {
+      for (const auto& p : model.parameters) names_taken.insert(p.name);
+      for (const auto& x : model.signals) names_taken.insert(x.name);
+      for (const auto& [name, value] : model.constants) names_taken.insert(name);
+    }
     std::string name;
     do name = fmt::format("C{}", ++constants_made);
-    while (model.parameter_index(name) >= 0 || model.signal(name) || model.constants.count(name));
+    while (names_taken.count(name));
+    names_taken.insert(name);
     return name;
   }
 
@@ -164,7 +197,7 @@ struct Integrator {
     const bool initial = e.integration.constants == ir::IntegrationRequest::Constants::initial;
     for (auto& term : e.terms) term.operation = antiderivative(term.operation, initial);
     e.known = antiderivative(e.known, initial);
-    if (!initial) {  // eq. 2-2.4: the constant of this integration becomes a parameter
+    if (!initial && !trial) {  // eq. 2-2.4: the constant of this integration becomes a parameter
       model.parameters.push_back({next_constant_name(), ir::Parameter::Origin::integration_constant, e.span,
                                   static_cast<int>(equation_index), std::nullopt});
       e.terms.push_back({static_cast<int>(model.parameters.size()) - 1, ir::number(1)});
@@ -187,11 +220,12 @@ struct Integrator {
       const int highest = derivative_burden(e);
       int best = highest;
       times = 0;
-      ir::Model scratch = model;
-      Integrator trial{scratch, diagnostics, constants_made};
+      // Without copying the model per equation (quadratic in the equations): a constant's term
+      // on a power of tau estimates no derivative, so the trial leaves them out.
+      Integrator measure{model, diagnostics, constants_made, true, {}};
       ir::Equation current = e;
       for (int n = 1; n <= std::min(highest, kMaxIntegrations); ++n) {
-        current = trial.once(current, index);
+        current = measure.once(current, index);
         if (const int b = derivative_burden(current); b < best) best = b, times = n;
       }
     }
@@ -211,7 +245,8 @@ struct Integrator {
 }  // namespace
 
 Sum antiderivative(const Sum& s, bool initial) {
-  std::vector<Term> remaining = s.terms, result;
+  RemainingTerms remaining(s);
+  std::vector<Term> result;
   while (!remaining.empty()) {
     const Term t = remaining.front();
     if (auto exact = exact_antiderivative(t, remaining, initial)) {
@@ -219,7 +254,7 @@ Sum antiderivative(const Sum& s, bool initial) {
       result.insert(result.end(), piece.terms.begin(), piece.terms.end());
       continue;
     }
-    remaining.erase(remaining.begin());
+    remaining.pop_front();
     const Sum numeric = integral_of(ir::canonical(std::vector<Term>{t}));  // vanishes at t0
     result.insert(result.end(), numeric.terms.begin(), numeric.terms.end());
   }
@@ -227,7 +262,7 @@ Sum antiderivative(const Sum& s, bool initial) {
 }
 
 ir::Model integrate_pass(ir::Model model, const IntegrateOptions& options, Diagnostics& diagnostics) {
-  Integrator integrator{model, diagnostics};
+  Integrator integrator{model, diagnostics, 0, false, {}};
   std::vector<ir::Equation> equations = model.equations;
   for (std::size_t i = 0; i < equations.size(); ++i) {
     ir::Equation e = equations[i];

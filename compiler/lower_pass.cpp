@@ -4,8 +4,10 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <set>
+#include <unordered_map>
 
 #include "ir/differentiate.hpp"
+#include "ir/node_budget.hpp"
 #include "ir/traversal.hpp"
 #include "compiler/parameter_split.hpp"
 #include "ir/print.hpp"
@@ -75,6 +77,14 @@ bool has_parameter(const Sum& s, std::string* name = nullptr) {
 
 Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
 
+// The nodes a product builds before like terms merge: every pair of terms, with both factor lists.
+std::size_t product_nodes(const Sum& a, const Sum& b) {
+  std::size_t factors_a = 0, factors_b = 0;
+  for (const auto& t : a.terms) factors_a += t.factors.size();
+  for (const auto& t : b.terms) factors_b += t.factors.size();
+  return a.terms.size() * b.terms.size() + factors_a * b.terms.size() + factors_b * a.terms.size();
+}
+
 struct Lowerer {
   const ParseResult& parsed;
   Diagnostics& diagnostics;
@@ -83,12 +93,35 @@ struct Lowerer {
   std::vector<std::pair<std::string, long long>> indices;  // sum indices in scope, innermost last
   Context context;
   bool failed = false;  // set by any error in the expression being lowered
+  // Symbolic work, model-wide (ir/node_budget.hpp): nodes built by sums, products, powers and
+  // derivatives; nodes of the lowered expressions written out in full.
+  ir::NodeBudget built{ir::kMaxNodesBuilt};
+  ir::NodeBudget written{ir::kMaxNodesWritten};
+  long double sum_expansion = 1;  // how many times the enclosing sums write out what is lowered now
+  bool budget_reported = false;    // the budget's error is told once, where it ran out
 
   Span span(const boost::spirit::x3::position_tagged& node) const { return parsed.span(node); }
+
+  // Model::parameter_index, by a map kept up to date with the implicit parameters lowering adds:
+  // a search through 10 000 parameters for every name of a large sum was quadratic.
+  std::unordered_map<std::string, int> parameter_indices;
+  int parameter_index(const std::string& name) {
+    const auto& list = decl.model.parameters;
+    for (auto k = parameter_indices.size(); k < list.size(); ++k) parameter_indices.emplace(list[k].name, static_cast<int>(k));
+    const auto it = parameter_indices.find(name);
+    return it == parameter_indices.end() ? -1 : it->second;
+  }
 
   void report(Diagnostic d) {
     failed = true;
     diagnostics.add(std::move(d));
+  }
+
+  // The model-wide budget ran out here: said once, as everything lowered after fails the same way.
+  void over_budget(Diagnostic d) {
+    failed = true;
+    if (!budget_reported) diagnostics.add(std::move(d));
+    budget_reported = true;
   }
 
   std::vector<std::string> known_names() const {
@@ -106,7 +139,7 @@ struct Lowerer {
   }
 
   Sum parameter(const std::string& name, const Span& where) {
-    int index = decl.model.parameter_index(name);
+    int index = parameter_index(name);
     if (index < 0 && !context.new_parameters) {
       std::vector<std::string> candidates;
       for (const auto& p : decl.model.parameters) candidates.push_back(p.name);
@@ -133,8 +166,12 @@ struct Lowerer {
 
   Sum operator()(const ast::Variable& v) {
     const std::string& name = v.name.name;
-    const int order = static_cast<int>(v.primes.size());
     const Span where = span(v);
+    if (v.primes.size() > static_cast<std::size_t>(kMaxDerivativeOrder)) {
+      report(diag::derivative_order_too_high(where, static_cast<long long>(v.primes.size()), kMaxDerivativeOrder));
+      return {};
+    }
+    const int order = static_cast<int>(v.primes.size());
     auto constant_value = [&](const Number& value) -> Sum {
       if (order > 0) {
         report(diag::derivative_of_constant(where, name));
@@ -170,12 +207,12 @@ struct Lowerer {
       report(diag::wrong_arity(where, name, name == "der" ? "an expression and an order" : "one argument", 0));
       return {};
     }
-    const bool implicit = !decl.parameters_declared && decl.model.parameter_index(name) < 0;
+    const bool implicit = !decl.parameters_declared && parameter_index(name) < 0;
     if (implicit && order > 0) {  // differentiated, so meant as a signal: say so
       report(diag::unknown_name(where, name, diag::nearest(name, known_names()), false));
       return {};
     }
-    if (decl.model.parameter_index(name) >= 0 || (!decl.parameters_declared && context.parameters)) {
+    if (parameter_index(name) >= 0 || (!decl.parameters_declared && context.parameters)) {
       if (!context.parameters) return not_allowed(where, name);
       if (order > 0) {
         report(diag::derivative_of_parameter(where, name));
@@ -276,7 +313,7 @@ struct Lowerer {
   Sum operator()(const ast::SumOver& s) {
     const std::string& name = s.index.name;
     const Span where = span(s);
-    if (decl.names.count(name) || is_builtin_name(name) || index_value(name) || decl.model.parameter_index(name) >= 0) {
+    if (decl.names.count(name) || is_builtin_name(name) || index_value(name) || parameter_index(name) >= 0) {
       report(diag::index_shadows(span(s.index), name));
       return {};
     }
@@ -288,18 +325,33 @@ struct Lowerer {
       report(diag::range_too_large(where, static_cast<long long>(s.to) - s.from + 1, kMaxFamilySize));
       return {};
     }
+    // Refused before anything is expanded when its range times those of the sums around it is
+    // more than the budget could build (each copy of the body is at least one node).
+    const long double expansion = sum_expansion * static_cast<long double>(static_cast<long long>(s.to) - s.from + 1);
+    if (!built.allows(expansion)) {
+      over_budget(diag::sum_too_large(where, expansion, built.limit()));
+      return {};
+    }
+    const long double outer_expansion = sum_expansion;
+    sum_expansion = expansion;
     std::vector<Term> terms;
     for (long long k = s.from; k <= s.to; ++k) {
       indices.emplace_back(name, k);
       Sum body = lower(s.body);
       indices.pop_back();
-      if (failed) return {};
+      if (failed || !built.spend(1 + body.terms.size())) {
+        sum_expansion = outer_expansion;
+        if (built.exceeded()) over_budget(diag::sum_too_large(where, expansion, built.limit()));
+        return {};
+      }
       if (terms.size() + body.terms.size() > kMaxTerms) {
+        sum_expansion = outer_expansion;
         report(diag::expression_too_large(where, kMaxTerms));
         return {};
       }
       terms.insert(terms.end(), body.terms.begin(), body.terms.end());
     }
+    sum_expansion = outer_expansion;
     return ir::canonical(std::move(terms));
   }
 
@@ -309,8 +361,8 @@ struct Lowerer {
     const int primes = static_cast<int>(c.callee.primes.size());
     if (ir::Signal* s = decl.model.signal(name)) return initial_value(c, *s, primes);
     if (!is_function_name(name)) {
-      if (decl.names.count(name) || decl.model.parameter_index(name) >= 0 || index_value(name) || is_builtin_name(name)) {
-        const char* what = decl.model.parameter_index(name) >= 0 ? "a parameter" : "a constant";
+      if (decl.names.count(name) || parameter_index(name) >= 0 || index_value(name) || is_builtin_name(name)) {
+        const char* what = parameter_index(name) >= 0 ? "a parameter" : "a constant";
         report(diag::not_callable(where, name, what));
       } else {
         std::vector<std::string> candidates = function_names();
@@ -416,14 +468,31 @@ struct Lowerer {
       }
       const Sum inner = ir::canonical(std::vector<Term>{rest});
       Sum d;
-      if (auto symbolic = differentiate(inner, order)) d = std::move(*symbolic);
-      else d = ir::factor(Factor{FactorKind::derivative, "", order, {}, {}, ir::share(inner), {}}, 1, where);
+      if (auto symbolic = differentiate(inner, order, built)) {
+        d = std::move(*symbolic);
+      } else if (built.exceeded()) {
+        over_budget(diag::derivative_too_large(where, built.limit()));
+        return {};
+      } else {
+        d = ir::factor(Factor{FactorKind::derivative, "", order, {}, {}, ir::share(inner), {}}, 1, where);
+      }
+      if (!built.spend(d.terms.size())) {
+        over_budget(diag::derivative_too_large(where, built.limit()));
+        return {};
+      }
       for (const auto& x : d.terms) terms.push_back(ir::multiply(constant, x));
     }
     return ir::canonical(std::move(terms));
   }
 
-  Sum lower(const ast::Operand& operand) { return boost::apply_visitor(*this, operand); }
+  // Each operand lowered is a node built: the budget bounds the walk of sums' bodies too.
+  Sum lower(const ast::Operand& operand) {
+    if (!built.spend(1)) {
+      failed = true;
+      return {};
+    }
+    return boost::apply_visitor(*this, operand);
+  }
 
   Sum lower(const ast::Expression& e) {
     Sum result = lower(e.first);
@@ -448,6 +517,10 @@ struct Lowerer {
           report(diag::expression_too_large(where, kMaxTerms));
           return {};
         }
+        if (!built.spend(product_nodes(result, operand))) {
+          over_budget(diag::expansion_too_large(where, built.limit()));
+          return {};
+        }
         result = ir::multiply(result, operand);
       } else if (step.op == '/') {
         std::string name;
@@ -462,6 +535,10 @@ struct Lowerer {
           }
           result = ir::scale(result, Number(1) / *n);
         } else {
+          if (!built.spend(result.terms.size())) {
+            over_budget(diag::expansion_too_large(where, built.limit()));
+            return {};
+          }
           result = ir::multiply(result, reciprocal(operand));
         }
       } else {  // '^'
@@ -475,22 +552,36 @@ struct Lowerer {
           report(diag::exponent_not_constant(where));
           return {};
         }
+        if (!std::isfinite(exponent->value())) {  // `y^2^2^2^2^2`, `y^(10^400)`
+          report(diag::number_overflows(where, "the exponent"));
+          return {};
+        }
         if (has_parameter(result, &name) && !exponent->is_one()) {
           report(diag::nonlinear_parameter(where, name, fmt::format("it is raised to the power {}", exponent->to_string())));
           return {};
         }
         if (auto base = result.as_number(); base && !(base->is_zero() && exponent->is_negative())) {
-          result = exponent->is_integer() ? ir::number(base->pow(exponent->numerator()), where)
-                                          : ir::number(Number::real(std::pow(base->value(), exponent->value())), where);
+          const Number power = exponent->is_integer() ? base->pow(exponent->numerator())
+                                                      : Number::real(std::pow(base->value(), exponent->value()));
+          if (!std::isfinite(power.value())) {
+            report(diag::number_overflows(where, "this power"));
+            return {};
+          }
+          result = ir::number(power, where);
           continue;
+        }
+        if (std::abs(exponent->value()) > static_cast<double>(kMaxExponent)) {
+          report(diag::exponent_too_large(where, exponent->to_string(), kMaxExponent));
+          return {};
         }
         if (result.empty() && exponent->is_negative()) {
           report(diag::division_by_zero(where));
           return {};
         }
-        auto raised = raise(result, *exponent, kMaxTerms);
+        auto raised = raise(result, *exponent, kMaxTerms, &built);
         if (!raised) {
-          report(diag::expression_too_large(where, kMaxTerms));
+          if (built.exceeded()) over_budget(diag::expansion_too_large(where, built.limit()));
+          else report(diag::expression_too_large(where, kMaxTerms));
           return {};
         }
         result = std::move(*raised);
@@ -505,13 +596,49 @@ struct Lowerer {
     context = std::move(c);
     failed = false;
     Sum s = lower(e);
-    if (failed) return std::nullopt;
+    if (failed) {
+      if (built.exceeded()) over_budget(diag::expansion_too_large(span(e), built.limit()));
+      return std::nullopt;
+    }
     for (const auto& t : s.terms)
       if (!std::isfinite(t.coefficient.value())) {
         report(diag::not_a_number(t.span.known() ? t.span : span(e), "a coefficient (it overflows to infinity here)"));
         return std::nullopt;
       }
+    if (!within_limits(s, span(e))) return std::nullopt;
     return s;
+  }
+
+  // What the runtime could not evaluate or the compiled model could not hold: more nodes written
+  // out than the model may have, a derivative order past kMaxDerivativeOrder (orders of der() and
+  // primes add up), a power past kMaxExponent (`(y^10000)^2`).
+  bool within_limits(const Sum& s, const Span& whole) {
+    // First the size, which bounds the walks below however the IR shares what it holds.
+    if (!written.spend(ir::written_nodes(s, written.remaining()))) {
+      over_budget(diag::model_too_many_nodes(whole, written.limit()));
+      return false;
+    }
+    for (const auto& t : s.terms) {
+      const Span where = t.span.known() ? t.span : whole;
+      const int order = ir::highest_derivative_order(Sum{{t}});
+      if (order > kMaxDerivativeOrder) {
+        report(diag::derivative_order_too_high(where, order, kMaxDerivativeOrder));
+        return false;
+      }
+      std::string exponent;
+      ir::for_each_term(Sum{{t}}, [&](const Term& inner) {
+        for (const auto& [f, power] : inner.factors) {
+          if (std::abs(power) > kMaxExponent) exponent = std::to_string(power);
+          if (f.kind == FactorKind::power && std::abs(f.exponent.value()) > static_cast<double>(kMaxExponent))
+            exponent = f.exponent.to_string();
+        }
+      });
+      if (!exponent.empty()) {
+        report(diag::exponent_too_large(where, exponent, kMaxExponent));
+        return false;
+      }
+    }
+    return true;
   }
 };
 
@@ -606,7 +733,7 @@ std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement&
 }  // namespace
 
 LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Diagnostics& diagnostics) {
-  Lowerer l{parsed, diagnostics, declarations, {}, {}, {}, false};
+  Lowerer l{parsed, diagnostics, declarations, {}, {}, {}, false, ir::NodeBudget{ir::kMaxNodesBuilt}, ir::NodeBudget{ir::kMaxNodesWritten}, 1, false, {}};
   for (const auto& c : declarations.constants) {
     auto value = l.lower_in(*c.value, Context{false, false, false, "a constant", {}});
     if (!value) continue;

@@ -15,21 +15,23 @@ bool estimates_derivative(const ir::Term& t) { return ir::highest_derivative_ord
 }  // namespace
 
 ir::Sum weak_integrand(const ir::Sum& s, int k) {
-  std::vector<ir::Term> remaining = s.terms;
-  ir::Sum result;
+  RemainingTerms remaining(s);
+  std::vector<ir::Term> result;  // made canonical once: adding term by term was quadratic
   while (!remaining.empty()) {
     const ir::Term t = remaining.front();
     if (estimates_derivative(t)) {
       if (auto antiderivative = exact_antiderivative(t, remaining, false)) {
         // By parts: phi_j^(k) vanishes at both ends of the subdomain, so no boundary term.
-        result = ir::add(result, ir::negate(weak_integrand(*antiderivative, k + 1)));
+        const ir::Sum moved = ir::negate(weak_integrand(*antiderivative, k + 1));
+        result.insert(result.end(), moved.terms.begin(), moved.terms.end());
         continue;
       }
     }
-    remaining.erase(remaining.begin());
-    result = ir::add(result, ir::multiply(test_function(k), ir::canonical(std::vector<ir::Term>{t})));
+    remaining.pop_front();
+    const ir::Sum kept = ir::multiply(test_function(k), ir::canonical(std::vector<ir::Term>{t}));
+    result.insert(result.end(), kept.terms.begin(), kept.terms.end());
   }
-  return result;
+  return ir::canonical(std::move(result));
 }
 
 ir::Model weak_pass(ir::Model model, Diagnostics&) {

@@ -143,6 +143,18 @@ Diagnostic statement_too_long(const Span& where, std::size_t limit) {
                "split it into several equations, or name parts of it with `const`");
 }
 
+Diagnostic too_many_statements(const Span& where, std::size_t limit) {
+  return error("too-many-statements", where, fmt::format("the model has more than {} statements; the rest was not read", limit),
+               "write families (`param c[1..50]`) and sums (`sum(k = 1..50, c[k]*y^k)`) instead of one statement each, "
+               "or split the model into several files");
+}
+
+Diagnostic too_many_equations(const Span& where, std::size_t limit) {
+  return error("too-many-equations", where, fmt::format("the model has more than {} equations; the rest was not read", limit),
+               "write families and sums (`sum(k = 1..50, c[k]*y^k)`) instead of one equation each, or split the model into "
+               "several files");
+}
+
 Diagnostic too_many_syntax_errors(const Span& where, int limit) {
   Diagnostic d = error("too-many-errors", where, fmt::format("stopped after {} syntax errors", limit),
                        "fix these first; the rest of the file was not read");
@@ -325,6 +337,53 @@ Diagnostic division_by_zero(const Span& where) {
 Diagnostic expression_too_large(const Span& where, std::size_t limit) {
   return error("expression-too-large", where, fmt::format("expanding this expression gives more than {} terms", limit),
                "write the product out more compactly, or name a part with `const`");
+}
+
+Diagnostic derivative_too_large(const Span& where, std::size_t limit) {
+  return error("derivative-too-large", where,
+               fmt::format("this derivative takes more than {} nodes (terms and factors) to write out, the most a model may build", limit),
+               "lower the order or nest fewer functions; each order of a nested function multiplies its terms");
+}
+
+Diagnostic expansion_too_large(const Span& where, std::size_t limit) {
+  return error("expansion-too-large", where,
+               fmt::format("expanding this builds more than {} nodes (terms and factors), the most a model may build", limit),
+               "write the product or power out more compactly, or name a part with `const`");
+}
+
+Diagnostic model_too_many_nodes(const Span& where, std::size_t limit) {
+  return error("model-too-many-nodes", where,
+               fmt::format("the model, written out, reaches more than {} nodes (terms and factors) here", limit),
+               "write fewer or smaller equations, or split the model into several files");
+}
+
+Diagnostic sum_too_large(const Span& where, long double count, std::size_t limit) {
+  return error("sum-too-large", where,
+               fmt::format("this sum would write out its body {:.3g} times (its range times the ranges of the sums "
+                           "around it), more than the {} nodes a model may build",
+                           static_cast<double>(count), limit),
+               "use shorter ranges, or fewer sums inside sums");
+}
+
+Diagnostic number_overflows(const Span& where, std::string_view what) {
+  return error("number-overflows", where, fmt::format("{} overflows: it is beyond about 1.8e308", what),
+               "use a smaller number; no record can be evaluated with it");
+}
+
+Diagnostic exponent_too_large(const Span& where, std::string_view exponent, long long limit) {
+  return error("exponent-too-large", where, fmt::format("the exponent {} is beyond {}", exponent, limit),
+               fmt::format("a power of a signal must lie between -{0} and {0}; larger ones overflow on any record", limit));
+}
+
+Diagnostic derivative_order_too_high(const Span& where, long long order, int limit) {
+  return error("derivative-order-too-high", where,
+               fmt::format("a derivative of order {} is beyond the highest sidc estimates, {}", order, limit),
+               "count the primes; a record cannot give derivatives that high");
+}
+
+Diagnostic empty_fit_window_setting(const Span& where, std::string_view from, std::string_view to, const Span& other) {
+  return error("empty-fit-window", where, fmt::format("the fit window is empty: `from` = {} is after `to` = {}", from, to),
+               fmt::format("the other end is set on {}; `from` must be the earlier time", line_of(other)));
 }
 
 Diagnostic not_a_number(const Span& where, std::string_view what) {

@@ -78,6 +78,9 @@ Diagnostic unexpected_character(const Span& where, unsigned char c);
 Diagnostic non_ascii_character(const Span& where, std::string_view character);
 Diagnostic nesting_too_deep(const Span& where, int limit);
 Diagnostic statement_too_long(const Span& where, std::size_t limit);
+// The file holds more statements than the parser reads (`where`: the first one past the limit).
+Diagnostic too_many_statements(const Span& where, std::size_t limit);
+Diagnostic too_many_equations(const Span& where, std::size_t limit);
 // A note ending the list when the parser stopped after `limit` errors.
 Diagnostic too_many_syntax_errors(const Span& where, int limit);
 // A statement the parser could not read for a reason it cannot name (an internal failure such
@@ -117,6 +120,19 @@ Diagnostic bad_derivative_order(const Span& where);
 Diagnostic exponent_not_constant(const Span& where);
 Diagnostic division_by_zero(const Span& where);
 Diagnostic expression_too_large(const Span& where, std::size_t limit);
+// Budgets of symbolic work, counted in nodes (a term or a factor; what a function, power, der(),
+// int() or guard holds counts again wherever it stands, as printing writes it out).
+Diagnostic derivative_too_large(const Span& where, std::size_t limit);
+Diagnostic expansion_too_large(const Span& where, std::size_t limit);
+Diagnostic model_too_many_nodes(const Span& where, std::size_t limit);
+// `count`: how many times the body would be expanded (this range times the ranges around it).
+Diagnostic sum_too_large(const Span& where, long double count, std::size_t limit);
+// A constant (`what`: "the exponent", "the power") outside the range of double.
+Diagnostic number_overflows(const Span& where, std::string_view what);
+Diagnostic exponent_too_large(const Span& where, std::string_view exponent, long long limit);
+Diagnostic derivative_order_too_high(const Span& where, long long order, int limit);
+// `set from` not before `set to`: the fit window is empty (`where`: the later of the two settings).
+Diagnostic empty_fit_window_setting(const Span& where, std::string_view from, std::string_view to, const Span& other);
 Diagnostic not_a_number(const Span& where, std::string_view what);
 Diagnostic input_definition_uses_signal(const Span& where, std::string_view input, std::string_view name);
 Diagnostic binding_unknown_signal(const Span& where, std::string_view name, std::string_view nearest);

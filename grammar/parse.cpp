@@ -213,9 +213,13 @@ bool read_statement(ParseResult& result, const parser::StatementExtent& extent) 
 void read_statements(ParseResult& result) {
   const std::string_view text = result.source->text;
   int errors = 0;
-  std::size_t from = 0;
+  std::size_t from = 0, statements = 0, equations = 0;
   while (const auto extent = parser::next_statement(text, from)) {
     from = extent->next;
+    if (++statements > parser::statement_limit) {
+      result.diagnostics.add(diag::too_many_statements(Span{result.source, extent->begin, extent->begin + 1}, parser::statement_limit));
+      return;
+    }
     if (errors == error_limit) {
       result.diagnostics.add(diag::too_many_syntax_errors(Span{result.source, extent->begin, extent->begin}, error_limit));
       return;
@@ -227,7 +231,12 @@ void read_statements(ParseResult& result) {
       ++errors;
       continue;
     }
-    if (!read_statement(result, *extent)) ++errors;
+    if (!read_statement(result, *extent)) {
+      ++errors;
+    } else if (boost::get<ast::Equation>(&result.model.statements.back().get()) && ++equations > parser::equation_limit) {
+      result.diagnostics.add(diag::too_many_equations(Span{result.source, extent->begin, extent->begin + 1}, parser::equation_limit));
+      return;
+    }
   }
 }
 

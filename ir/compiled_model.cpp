@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <fmt/format.h>
 #include <set>
+#include <unordered_map>
 
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
@@ -137,13 +138,21 @@ std::string one_of(const json& j, const char* field, std::initializer_list<const
   throw std::runtime_error(fmt::format("`{}` is not a valid {}", value, field));
 }
 
-// No model asks for more (the moving arc of order k needs k*(window-1) samples); larger or
-// negative orders only come from a damaged file.
-constexpr int kMaxOrder = 64;
+// No model asks for more (the compiler refuses them; the moving arc of order k needs
+// k*(window-1) samples); larger or negative orders only come from a damaged file.
+constexpr int kMaxOrder = kMaxDerivativeOrder;
+
+// The deepest nesting of sums in functions, powers, der(), int() and guards a compiled model may
+// hold (docs/compiled-model.md). The compiler writes at most the parser's 200 levels plus one per
+// integration; a file nested deeper was not written by it and is refused as soon as the reader's
+// recursion reaches the limit, in time linear in what it read (compiler/load_model.cpp refuses
+// deeper JSON before it is parsed).
+constexpr int kMaxCompiledNesting = 256;
 
 struct Reader {
   std::shared_ptr<const SourceFile> source;
   std::set<std::string> signals;
+  mutable int depth = 0;  // of the sum being read: functions, powers, der(), int() and guards nest
 
   Span span(const json& j) const {
     if (j.is_null()) return {};
@@ -158,6 +167,18 @@ struct Reader {
   }
   ir::SumPtr sum_ptr(const json& j) const { return ir::share(sum(j)); }
   ir::Sum sum(const json& j) const {
+    // Each level recurses here: a damaged file nested deeper than any compiler output is refused
+    // before it can exhaust the stack.
+    struct Level {
+      int& depth;
+      explicit Level(int& d) : depth(d) {
+        if (++depth > kMaxCompiledNesting)
+          throw std::runtime_error(fmt::format("an expression nested more than {} levels deep", kMaxCompiledNesting));
+      }
+      ~Level() { --depth; }
+      Level(const Level&) = delete;
+      Level& operator=(const Level&) = delete;
+    } level(depth);
     std::vector<ir::Term> terms;
     for (const auto& t : j.at("terms")) {
       ir::Term term{number(t.at("coefficient")), {}, span(t.at("span"))};
@@ -222,18 +243,27 @@ ordered plots_json(const ir::Model& m) {
   return plots;
 }
 
-// Equations of the model from their JSON, parameters looked up by name in `m`.
-std::vector<ir::ParameterTerm> read_operations(const json& j, const ir::Model& m, const Reader& r) {
+// Each parameter's index by its name (the first of a name, as Model::parameter_index): one look-up
+// per operation instead of a search through every parameter, which was quadratic.
+using ParameterIndices = std::unordered_map<std::string, int>;
+ParameterIndices parameter_indices(const ir::Model& m) {
+  ParameterIndices indices;
+  for (std::size_t k = 0; k < m.parameters.size(); ++k) indices.emplace(m.parameters[k].name, static_cast<int>(k));
+  return indices;
+}
+
+// Equations of the model from their JSON, parameters looked up by name in `indices`.
+std::vector<ir::ParameterTerm> read_operations(const json& j, const ParameterIndices& indices, const Reader& r) {
   std::vector<ir::ParameterTerm> terms;
   for (const auto& o : j) {
-    const int index = m.parameter_index(o.at("parameter").get<std::string>());
-    if (index < 0) throw std::runtime_error("an operation names an undeclared parameter");
-    terms.push_back({index, r.sum(o.at("operation"))});
+    const auto index = indices.find(o.at("parameter").get<std::string>());
+    if (index == indices.end()) throw std::runtime_error("an operation names an undeclared parameter");
+    terms.push_back({index->second, r.sum(o.at("operation"))});
   }
   return terms;
 }
 
-std::vector<ir::Equation> read_equations(const json& j, const ir::Model& m, const Reader& r) {
+std::vector<ir::Equation> read_equations(const json& j, const ParameterIndices& m, const Reader& r) {
   std::vector<ir::Equation> equations;
   for (const auto& e : j) {
     ir::Equation eq;
@@ -362,7 +392,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
     c.source = std::make_shared<const SourceFile>(j.at("source").at("path").get<std::string>(), j.at("source").at("text").get<std::string>());
     if (j.at("source").at("hash").get<std::string>() != source_hash(c.source->text))
       throw std::runtime_error("the source text does not match its hash");
-    Reader r{c.source, {}};
+    Reader r{c.source, {}, 0};
     for (const auto& s : j.at("signals")) r.signals.insert(s.at("name").get<std::string>());
     ir::Model& m = c.integrated;
     m.name = j.at("model").get<std::string>();
@@ -419,6 +449,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
     // the equations and the integration constants, which follow the model's own parameters.
     ir::Model normalized = m;
     std::erase_if(normalized.parameters, [](const ir::Parameter& p) { return p.origin == ir::Parameter::Origin::integration_constant; });
+    const ParameterIndices normalized_indices = parameter_indices(normalized);
     for (const auto& p : j.at("plots")) {
       ir::PlotFunction plot;
       plot.name = p.at("name").get<std::string>();
@@ -427,15 +458,15 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       if (!r.signals.count(plot.signal)) throw std::runtime_error("a plot names the undeclared signal `" + plot.signal + "`");
       plot.order = p.at("order").get<int>();
       if (plot.order < 0 || plot.order > kMaxOrder) throw std::runtime_error(fmt::format("a plot against a derivative of order {}", plot.order));
-      plot.terms = read_operations(p.at("operations"), normalized, r);
+      plot.terms = read_operations(p.at("operations"), normalized_indices, r);
       plot.rest = r.sum(p.at("rest"));
       if (!p.at("truth").is_null()) plot.truth = r.sum(p.at("truth"));
       normalized.plots.push_back(std::move(plot));
     }
     // Plots name the model's own parameters, whose indices are the same in both forms.
     m.plots = normalized.plots;
-    normalized.equations = read_equations(j.at("normalized"), normalized, r);
-    m.equations = read_equations(j.at("equations"), m, r);
+    normalized.equations = read_equations(j.at("normalized"), normalized_indices, r);
+    m.equations = read_equations(j.at("equations"), parameter_indices(m), r);
     m.form_from_data = j.value("form_from_data", false);
     check_test_functions(m, normalized);
     c.normalized = std::move(normalized);

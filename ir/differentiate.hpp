@@ -10,11 +10,16 @@
 #include <optional>
 
 #include "ir/ir.hpp"
+#include "ir/node_budget.hpp"
 
 namespace sidc {
 
 std::optional<ir::Sum> differentiate(const ir::Sum& s, int times = 1);
 std::optional<ir::Sum> differentiate(const ir::Term& t);
+// As differentiate(s, times), spending the nodes written out of every term it builds from
+// `budget`: returns nullopt, with budget.exceeded(), as soon as the budget is spent, so that a
+// derivative that grows exponentially (der() of nested functions) stops early.
+std::optional<ir::Sum> differentiate(const ir::Sum& s, int times, ir::NodeBudget& budget);
 
 // The partial derivative of `s` with respect to the signal derivative `signal`^(order), every
 // other signal derivative, t and the parameters held constant: the Jacobian of a right-hand side,
@@ -24,8 +29,11 @@ std::optional<ir::Sum> partial_derivative(const ir::Sum& s, const std::string& s
 
 // 1/u as a sum: inverted powers for a single term, else the factor (u)^-1.
 ir::Sum reciprocal(const ir::Sum& u);
-// u^e: expanded for a non-negative integer e (nullopt if more than `max_terms` terms would result),
-// folded into powers for a single term, else the factor (u)^e.
-std::optional<ir::Sum> raise(const ir::Sum& u, const Number& e, std::size_t max_terms = 20000);
+// u^e: expanded for a non-negative integer e (nullopt if more than `max_terms` terms would result,
+// or if the terms multiplied on the way overspend `budget`), folded into powers for a single term,
+// else the factor (u)^e. When the terms of u are products of independent factors (`y + x + t`),
+// u^e has exactly the multinomial count of terms, C(e + n - 1, n - 1) for n terms, and a power
+// that would exceed `max_terms` is refused before anything is multiplied.
+std::optional<ir::Sum> raise(const ir::Sum& u, const Number& e, std::size_t max_terms = 20000, ir::NodeBudget* budget = nullptr);
 
 }  // namespace sidc

@@ -43,6 +43,15 @@ Number Number::real(double value) {
 }
 
 std::optional<Number> Number::parse(std::string_view text) {
+  // A decimal literal with an optional sign, nothing else: from_chars alone would also read
+  // `nan`, `inf` and `infinity`, which are no numbers of the language (`set from = nan`).
+  if (text.find_first_not_of("0123456789.eE+-") != std::string_view::npos) return std::nullopt;
+  if (!text.empty() && (text[0] == '-' || text[0] == '+')) {
+    if (text[0] == '+' || text.size() == 1 || text[1] == '-' || text[1] == '+') return std::nullopt;
+    const auto magnitude = parse(text.substr(1));
+    if (!magnitude) return std::nullopt;
+    return -*magnitude;
+  }
   double as_double = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), as_double);
   if (ec != std::errc() || end != text.data() + text.size()) {

@@ -13,6 +13,13 @@ namespace sidc {
 
 inline constexpr int kMaxFamilySize = 10000;  // members of one `param c[a..b]` or one `sum`
 inline constexpr int kMaxIntegrations = 8;
+// The highest derivative order a model may ask for, counting primes and der() orders together
+// (`der(y'', 3)` is of order 5). The compiled-model reader refuses higher ones, and no record gives
+// derivatives that high: the moving arc of order k needs a polynomial of degree k or more.
+inline constexpr int kMaxDerivativeOrder = 64;
+// The largest magnitude of an exponent on anything but a number (`y^10000`): beyond it every
+// value of a signal other than 0 and 1 overflows or vanishes, and expanding it costs as many steps.
+inline constexpr long long kMaxExponent = 10'000;
 
 struct SettingCheck {
   bool unknown_key = false;

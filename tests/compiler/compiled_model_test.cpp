@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "ir/compiled_model.hpp"
+#include "compiler/load_model.hpp"
 #include "compiler/pipeline.hpp"
 #include "json_schema.hpp"
 
@@ -432,6 +433,19 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
        }, {"undeclared signal `q`"}},
       {"weights that are not a sum", [](json& j) { j["weights_expression"] = {{"expression", 3}, {"span", nullptr}}; },
        {"m.sidc.json", "compile the model again"}},
+      {"an integral nested 300 deep (refused at level 257, before the recursion gets deep)", [](json& j) {
+         // Written as text with each nested value last, so that building it is linear here too.
+         std::string text = R"({"text": "y", "terms": [{"coefficient": {"num": 1, "den": 1}, "span": null, "factors": [{"kind": "signal", "name": "y", "order": 0, "power": 1}]}]})";
+         std::string open, close;
+         for (int k = 0; k < 300; ++k) {
+           open += R"J({"text": "int(...)", "terms": [{"coefficient": {"num": 1, "den": 1}, "span": null, "factors": [{"kind": "integral", "power": 1, "argument": )J";
+           close += "}]}]}";
+         }
+         j["equations"][0]["operations"][0]["operation"] = json::parse(open + text + close);
+       }, {"nested more than 256 levels deep"}},
+      {"a derivative order past the compiler's 64", [&](json& j) {
+         j[first_factor]["kind"] = "signal", j[first_factor]["name"] = "y", j[first_factor]["order"] = 65;
+       }, {"derivative order of 65"}},
   };
   for (const auto& b : breakages) {
     json broken = good;
@@ -442,6 +456,24 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
     EXPECT_EQ(error.rfind("error: ", 0), 0u) << b.what << ": " << error;
     for (const char* part : b.expected) EXPECT_NE(error.find(part), std::string::npos) << b.what << ": `" << part << "` not in: " << error;
   }
+}
+
+// A compiled model nested 20 000 levels deep is refused from its text, in one pass, before the JSON
+// library parses it (which copies members as it adds them: minutes at that depth).
+TEST(CompiledModelFile, DeepJsonIsRefusedBeforeParsing) {
+  const fs::path path = fs::temp_directory_path() / "sidc_deep_test.sidc.json";
+  {
+    std::ofstream out(path);
+    out << R"({"format": "sidc-compiled-model", "version": 2, "equations": [)";
+    for (int k = 0; k < 20000; ++k) out << R"({"terms": [{"factors": [{"kind": "integral", "argument": )";
+    out << "{}";
+    for (int k = 0; k < 20000; ++k) out << "}]}]}";
+    out << "]}";
+  }
+  std::string error, warnings;
+  EXPECT_FALSE(load_compiled_model(path.string(), error, warnings).has_value());
+  EXPECT_NE(error.find("nested more than 2000 levels deep"), std::string::npos) << error;
+  fs::remove(path);
 }
 
 // Values the reader takes today without a word and then misreads (a relation `=<` is read as

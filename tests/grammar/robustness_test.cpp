@@ -203,9 +203,30 @@ TEST(Robustness, LongStatementWithinTheLimitParsesInLinearTime) {
 }
 
 TEST(Robustness, ManyStatements) {
-  const ParseResult result = timed_parse("2000 statements", repeated("a1*y'' + a2*y = x\n", 2000));
-  EXPECT_EQ(result.model.statements.size(), 2000u);
+  const ParseResult result = timed_parse("1000 equations", repeated("a1*y'' + a2*y = x\n", parser::equation_limit));
+  EXPECT_EQ(result.model.statements.size(), parser::equation_limit);
   EXPECT_TRUE(result.diagnostics.items.empty());
+}
+
+// The statement and equation limits are exact, and a file of two million one-line equations
+// (5.9 GB once built) is refused at the first equation past the limit, without the rest being parsed.
+TEST(Robustness, StatementAndEquationLimitsAreExact) {
+  const ParseResult at_limit = timed_parse("10 000 statements", repeated("param a\n", parser::statement_limit));
+  EXPECT_EQ(at_limit.model.statements.size(), parser::statement_limit);
+  EXPECT_TRUE(at_limit.diagnostics.items.empty());
+  const ParseResult past_limit = timed_parse("2 000 000 statements", repeated("param a\n", 2'000'000));
+  EXPECT_EQ(diagnostic_codes(past_limit), "too-many-statements");
+  EXPECT_EQ(past_limit.model.statements.size(), parser::statement_limit);
+  ASSERT_EQ(past_limit.diagnostics.items.size(), 1u);
+  EXPECT_EQ(past_limit.diagnostics.items[0].span.start().line, static_cast<int>(parser::statement_limit) + 1);
+
+  const ParseResult equations = timed_parse("1 000 equations", repeated("y' = a\n", parser::equation_limit));
+  EXPECT_EQ(equations.model.statements.size(), parser::equation_limit);
+  EXPECT_TRUE(equations.diagnostics.items.empty());
+  const ParseResult millions = timed_parse("2 000 000 equations", repeated("y' = a\n", 2'000'000));
+  EXPECT_EQ(diagnostic_codes(millions), "too-many-equations");
+  ASSERT_EQ(millions.diagnostics.items.size(), 1u);
+  EXPECT_EQ(millions.diagnostics.items[0].span.start().line, static_cast<int>(parser::equation_limit) + 1);
 }
 
 TEST(Robustness, MutatedModelsNeverThrowAndPointInsideTheText) {

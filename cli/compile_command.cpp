@@ -1,13 +1,14 @@
 #include "cli/compile_command.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <filesystem>
 #include <map>
 #include <fmt/format.h>
 #include <iostream>
 
 #include "cli/exit_codes.hpp"
+#include "cli/form_options.hpp"
+#include "cli/output_check.hpp"
 #include "report/atomic_file.hpp"
 #include "ir/compiled_model.hpp"
 #include "compiler/pipeline.hpp"
@@ -23,8 +24,7 @@ namespace {
 struct CompileArguments {
   std::string model;
   std::string output;
-  std::string integrate;
-  std::string form;
+  FormArguments form_options;  // --integrate, --form (form_options.hpp)
   std::string dump;
   std::string dump_after;
 };
@@ -84,32 +84,16 @@ std::string summary(const ir::Model& m, const std::string& path) {
 int run_compile(const CompileArguments& a) {
   if (const auto input = input_overwritten_by(a.output, {a.model}); !input.empty())
     return fail(render(cli_diag::output_is_input(a.output, input)), exit_code::usage_error);
+  if (auto problem = output_problem("-o", a.output, OutputKind::file)) return fail(*problem, exit_code::user_error);
   auto text = read_text_file(a.model);
   if (auto* d = std::get_if<Diagnostic>(&text)) {
     std::cerr << render(cli_diag::model_not_read(*d)) << "\n";
     return exit_code::user_error;
   }
   CompileOptions options;
-  if (!a.integrate.empty()) {
-    ir::IntegrationRequest r;
-    if (a.integrate == "auto") {
-      r.count = ir::IntegrationRequest::Count::automatic;
-    } else {
-      int n = -1;
-      const auto [end, ec] = std::from_chars(a.integrate.data(), a.integrate.data() + a.integrate.size(), n);
-      if (ec != std::errc() || end != a.integrate.data() + a.integrate.size() || n < 0 || n > 8) {
-        std::cerr << render(diag::integrate_option_invalid(a.integrate)) << "\n";
-        return exit_code::usage_error;
-      }
-      r.times = n;
-    }
-    options.integrate.override_request = r;
-  }
-  if (!a.form.empty()) {  // the same request as --integrate, named by its form (CLI11 checked the value)
-    ir::IntegrationRequest r;
-    request_form(r, a.form);
-    options.integrate.override_request = r;
-  }
+  std::string error;
+  options.integrate.override_request = integration_request(a.form_options, error);
+  if (!error.empty()) return fail(error, exit_code::usage_error);
   const bool dumping = !a.dump.empty() || !a.dump_after.empty();
   if (dumping) {
     auto stop = pass_to_stop_after(a);
@@ -157,10 +141,7 @@ void add_compile_command(CLI::App& app, int& exit_status) {
   CLI::App* cmd = app.add_subcommand("compile", "Check a model file, rewrite it into integrated form, and write the compiled model");
   cmd->add_option("model", args->model, "The model file (.sid)")->required();
   cmd->add_option("-o,--output", args->output, "Where to write the compiled model (default: MODEL with extension .sidc.json)");
-  auto* integrate = cmd->add_option("--integrate", args->integrate, "Integrate every equation N times (0-8), or `auto`; overrides the file");
-  cmd->add_option("--form", args->form, "Rewrite every equation into this form: derivative, integrated (as --integrate auto) or weak; overrides the file")
-      ->check(CLI::IsMember({"derivative", "integrated", "weak"}))
-      ->excludes(integrate);
+  add_form_options(cmd, args->form_options);
   auto* dump = cmd->add_option("--dump", args->dump, "Print one stage instead of compiling: ast, normalized or integrated");
   cmd->add_option("--dump-after", args->dump_after, "Print the model after the named pass (parse, declare, lower, normalize, units, integrate, weak, hold)")
       ->excludes(dump);

@@ -10,10 +10,16 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
+#include <tuple>
+#include <variant>
 
 #include "cli/exit_codes.hpp"
+#include "cli/form_options.hpp"
+#include "cli/output_check.hpp"
 #include "cli/record_options.hpp"
 #include "compiler/hold_check_pass.hpp"
+#include "compiler/integrate_pass.hpp"
+#include "compiler/weak_pass.hpp"
 #include "compiler/load_model.hpp"
 #include "compiler/pipeline.hpp"
 #include "diagnostics/cli_catalogue.hpp"
@@ -23,7 +29,6 @@
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
-#include "ir/settings.hpp"
 #include "runtime/refine/refine.hpp"
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
@@ -40,6 +45,7 @@ namespace fs = std::filesystem;
 
 struct FitArguments {
   std::vector<std::string> compiled;
+  FormArguments form_options;         // --integrate, --form (form_options.hpp), over the model's own
   RecordArguments records;            // --data, --from, --to, --every, ... (record_options.hpp)
   std::string out;
   bool no_validate = false;
@@ -52,25 +58,37 @@ struct FitArguments {
   std::string estimator;              // --estimator least_squares|iv, over the model's `set estimator`
 };
 
-// The compiled model to fit when none is named: the most recently compiled *.sidc.json in the
-// current directory, so that `sidc compile model.sid && sidc fit` fits that model.
-std::optional<std::string> default_compiled_model() {
-  std::vector<std::pair<fs::file_time_type, std::string>> found;
+// The compiled model to fit when none is named: the only *.sidc.json in the current directory, so
+// that `sidc compile model.sid && sidc fit` fits that model. With several, which one is not guessed.
+std::variant<std::string, std::string> default_compiled_model() {
+  std::vector<std::string> found;
   for (const auto& entry : fs::directory_iterator(fs::current_path()))
-    if (entry.is_regular_file() && entry.path().filename().string().ends_with(".sidc.json"))
-      found.emplace_back(entry.last_write_time(), entry.path().filename().string());
-  if (found.empty()) return std::nullopt;
-  std::sort(found.begin(), found.end());  // by time, then name: deterministic
-  if (found.size() > 1) std::cerr << render(cli_diag::fitting_most_recent(found.back().second)) << "\n";
-  return found.back().second;
+    if (entry.is_regular_file() && entry.path().filename().string().ends_with(".sidc.json")) found.push_back(entry.path().filename().string());
+  std::sort(found.begin(), found.end());
+  if (found.empty()) return std::variant<std::string, std::string>(std::in_place_index<1>, render(cli_diag::no_compiled_model()));
+  if (found.size() > 1) return std::variant<std::string, std::string>(std::in_place_index<1>, render(cli_diag::several_compiled_models(found)));
+  return std::variant<std::string, std::string>(std::in_place_index<0>, found.front());
 }
 
 // One model's fit, reported on stdout; its totals for a comparison table when asked.
-int fit_one(const std::string& compiled_path, const FitArguments& a, const std::string& out_dir, std::optional<ModelTotals>* totals) {
+int fit_one(const std::string& compiled_path, const FitArguments& a, const std::optional<ir::IntegrationRequest>& request, const std::string& out_dir,
+            std::optional<ModelTotals>* totals) {
   std::string error, warnings;
   auto compiled = load_compiled_model(compiled_path, error, warnings);
   std::cerr << warnings;
   if (!compiled) return fail(error, exit_code::user_error);
+  if (request) {
+    // --integrate/--form: every equation rewritten as `sidc compile` with the same option would.
+    IntegrateOptions rewrite;
+    rewrite.override_request = request;
+    Diagnostics problems;
+    ir::Model m = weak_pass(integrate_pass(compiled->normalized, rewrite, problems), problems);
+    hold_check_pass(m, problems);
+    std::cerr << problems.render_all();
+    if (problems.has_errors()) return exit_code::user_error;
+    m.form_from_data = false;
+    compiled->integrated = std::move(m);
+  }
   auto options = fit_options(compiled->integrated, a.records, error);
   if (!options) return fail(error, exit_code::usage_error);
   auto loaded = load_records(*compiled, compiled_path, a.records, error);
@@ -186,7 +204,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
                               refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables");
     if (validation->failed_record)
       return fail(render(cli_diag::cannot_validate(validation->failed_path, *validation->failed_record)), exit_code::user_error);
-    std::cout << validation_report(*validation);
+    std::cout << validation_report(*validation, records.size());
   }
   const ResidualAnalysis residuals = analyse_residuals(model, summary, records, *options);
   std::cout << residual_report(residuals);
@@ -217,19 +235,30 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
 
 int run_fit(const FitArguments& a) {
   std::vector<std::string> compiled_paths = a.compiled;
+  // `--data a.csv b.csv model.sid` once made b.csv and model.sid records; now --data takes one
+  // file, and a record where a model belongs is said to be one.
+  for (const auto& path : compiled_paths)
+    if (fs::path(path).extension() == ".csv") return fail(render(cli_diag::record_as_model(path)), exit_code::usage_error);
   if (compiled_paths.empty()) {
     auto found = default_compiled_model();
-    if (!found) return fail(render(cli_diag::no_compiled_model()), exit_code::user_error);
-    compiled_paths.push_back(*found);
+    if (found.index() == 1) return fail(std::get<1>(found), exit_code::user_error);
+    compiled_paths.push_back(std::get<0>(found));
   }
-  if (compiled_paths.size() == 1) return fit_one(compiled_paths.front(), a, a.out, nullptr);
+  // Outputs are checked before the work: a mistyped --out fails now, not after the fit.
+  for (const auto& [option, path, kind] : {std::tuple{"--out", a.out, OutputKind::directory}, std::tuple{"--plots", a.plots, OutputKind::directory},
+                                           std::tuple{"--report", a.report, OutputKind::file}})
+    if (auto problem = output_problem(option, path, kind)) return fail(*problem, exit_code::user_error);
+  std::string error;
+  const auto request = integration_request(a.form_options, error);
+  if (!error.empty()) return fail(error, exit_code::usage_error);
+  if (compiled_paths.size() == 1) return fit_one(compiled_paths.front(), a, request, a.out, nullptr);
   if (!a.plots.empty() || !a.report.empty()) return fail(render(cli_diag::pictures_of_several_models(compiled_paths.size())), exit_code::usage_error);
   std::vector<ModelTotals> totals;
   int status = exit_code::success;
   for (const auto& path : compiled_paths) {
     std::optional<ModelTotals> t;
     const std::string out = a.out.empty() ? "" : (fs::path(a.out) / fs::path(path).stem().stem()).string();
-    const int code = fit_one(path, a, out, &t);
+    const int code = fit_one(path, a, request, out, &t);
     if (code != exit_code::success && !t) return code;  // could not be fitted at all
     totals.push_back(*t);
     std::cout << "\n";
@@ -244,8 +273,9 @@ int run_fit(const FitArguments& a) {
 void add_fit_command(CLI::App& app, int& exit_status) {
   auto a = std::make_shared<FitArguments>();
   CLI::App* cmd = app.add_subcommand("fit", "Determine the parameters of a compiled model from records (thesis section 2-1)");
-  cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json), or model files (.sid) to compile first; default: the most recent compiled model here");
+  cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json), or model files (.sid) to compile first; default: the only compiled model here");
   add_record_options(cmd, a->records);
+  add_form_options(cmd, a->form_options);
   cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv and validation.csv");
   cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all)");
   cmd->add_option("--initial-state", a->initial_state,

@@ -1,19 +1,25 @@
 // sidc: determination of parameters and operations in dynamic systems (Bernhart, 1964).
 // This file only dispatches to the subcommands; each lives in its own *_command.cpp.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "cli/compile_command.hpp"
 #include "cli/exit_codes.hpp"
+#include "cli/export_command.hpp"
 #include "cli/fit_command.hpp"
 #include "cli/simulate_command.hpp"
 #include "cli/select_command.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "diagnostics/model_catalogue.hpp"
 
 namespace {
 
@@ -36,6 +42,7 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"sidc: identify the parameters and operations of dynamic systems from recorded data\n"
                "(the method of W. D. Bernhart, 1964). Main path: sidc compile model.sid && sidc fit"};
+  app.name("sidc");  // in --help, whatever path the binary was run by
   app.set_version_flag("--version", std::string("sidc ") + SIDC_VERSION);
   app.require_subcommand(1);
   int exit_status = sidc::exit_code::success;
@@ -44,11 +51,24 @@ int main(int argc, char** argv) {
     sidc::add_fit_command(app, exit_status);
     sidc::add_simulate_command(app, exit_status);
     sidc::add_select_command(app, exit_status);
+    sidc::add_export_command(app, exit_status);
+    // `sidc fitt`: CLI11 would say only that a subcommand is required; name the word and the nearest.
+    std::vector<std::string> names;
+    for (const auto* sub : app.get_subcommands(std::function<bool(CLI::App*)>{})) names.push_back(sub->get_name());
+    if (argc > 1 && argv[1][0] != '-' && std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      return sidc::fail(render(sidc::cli_diag::unknown_subcommand(argv[1], sidc::diag::nearest(argv[1], names), list)),
+                        sidc::exit_code::usage_error);
+    }
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-      const int code = app.exit(e);  // prints help, version or the usage error
-      return with_stdout_checked(code == 0 ? sidc::exit_code::success : sidc::exit_code::usage_error);
+      if (e.get_exit_code() == 0) return with_stdout_checked(app.exit(e));  // --help, --version: printed, success
+      // A usage error, in sidc's own error:/hint: frame, pointing at the subcommand's --help.
+      std::string command = "sidc";
+      for (const auto* sub : app.get_subcommands()) command += " " + sub->get_name();
+      return sidc::fail(render(sidc::cli_diag::usage(e.what(), command)), sidc::exit_code::usage_error);
     }
   } catch (const std::exception& e) {
     std::cerr << "internal error: " << e.what() << "\nThis is a bug in sidc; please report it with the input that caused it.\n";

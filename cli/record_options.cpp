@@ -30,7 +30,9 @@ const CLI::Validator positive = CLI::Validator(
 }  // namespace
 
 void add_record_options(CLI::App* cmd, RecordArguments& a) {
-  cmd->add_option("--data", a.data, "Record(s) to use instead of the model's data statements (CSV)");
+  // One file per --data: a word after it is never taken as a record (`--data a.csv model.sid`).
+  cmd->add_option("--data", a.data, "A record to use instead of the model's data statements (CSV); repeat it for several: --data a.csv --data b.csv")
+      ->allow_extra_args(false);
   cmd->add_option("--from", a.from, "Start of the fit window (time)");
   cmd->add_option("--to", a.to, "End of the fit window (time)");
   cmd->add_option("--every", a.every, "Keep every K-th sample")->check(positive);

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "cli/exit_codes.hpp"
+#include "cli/output_check.hpp"
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "compiler/pipeline.hpp"
@@ -44,6 +45,7 @@ struct SelectArguments {
 };
 
 int run_select(const SelectArguments& a) {
+  if (auto problem = output_problem("--out", a.out, OutputKind::directory)) return fail(*problem, exit_code::user_error);
   std::string error, warnings;
   auto compiled = load_compiled_model(a.model, error, warnings);
   std::cerr << warnings;

@@ -18,6 +18,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/exit_codes.hpp"
+#include "cli/fitted_values.hpp"
+#include "cli/output_check.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/settings.hpp"
@@ -89,25 +91,10 @@ std::variant<std::vector<double>, Failure> parameter_values(const ir::Model& mod
     auto text = read_whole_file(a.params_file, error);
     if (!text) return Failure{exit_code::user_error, error};
     const auto j = nlohmann::json::parse(*text, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || j.value("format", "") != "sidc-fit" || !j.contains("groups") || !j["groups"].is_array())
-      return Failure{exit_code::user_error, render(cli_diag::not_a_fit_file(a.params_file))};
-    for (const auto& g : j["groups"])
-      for (const auto& p : g.value("parameters", nlohmann::json::array()))
-        if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
-          if (auto f = assign(p["name"].get<std::string>(), p["estimate"].get<double>(), true)) return *f;
-    // A fit by instrumental variables (set estimator = iv) that converged, then one refined by the
-    // output error (sidc fit --refine): the last estimate made is the fit's answer.
-    const auto& iv = j.contains("instrumental_variables") ? j["instrumental_variables"] : nlohmann::json();
-    if (iv.is_object() && iv.value("termination", "") == "converged" && iv.contains("groups") && iv["groups"].is_array())
-      for (const auto& g : iv["groups"])
-        for (const auto& p : g.value("parameters", nlohmann::json::array()))
-          if (p.contains("name") && p["name"].is_string() && p.contains("estimate") && p["estimate"].is_number())
-            if (auto f = assign(p["name"].get<std::string>(), p["estimate"].get<double>(), true)) return *f;
-    const auto& refinement = j.contains("refinement") ? j["refinement"] : nlohmann::json();
-    if (refinement.is_object() && refinement.value("status", "") != "failed" && refinement.contains("parameters") && refinement["parameters"].is_array())
-      for (const auto& p : refinement["parameters"])
-        if (p.contains("name") && p["name"].is_string() && p.contains("refined") && p["refined"].is_number())
-          if (auto f = assign(p["name"].get<std::string>(), p["refined"].get<double>(), true)) return *f;
+    const auto fitted = fitted_values(j);
+    if (!fitted) return Failure{exit_code::user_error, render(cli_diag::not_a_fit_file(a.params_file))};
+    for (const auto& [name, value] : *fitted)
+      if (auto f = assign(name, value, true)) return *f;
   }
   for (const auto& text : a.params) {
     auto parsed = name_value(text, "--param", "a1=0.5");
@@ -149,6 +136,7 @@ std::variant<std::map<std::string, std::vector<std::optional<double>>>, Failure>
 
 int run_simulate(const SimulateArguments& a) {
   if (a.t0 && a.t1 && !(*a.t1 > *a.t0)) return fail(render(cli_diag::end_not_after_start(*a.t1, *a.t0)), exit_code::usage_error);
+  if (auto problem = output_problem("-o", a.out, OutputKind::file)) return fail(*problem, exit_code::user_error);
   std::string error, warnings;
   auto compiled = load_compiled_model(a.model, error, warnings);
   std::cerr << warnings;
@@ -266,12 +254,14 @@ int run_simulate(const SimulateArguments& a) {
   const std::string report = fmt::format("sidc simulate: model `{}`, {} ({}), initial state {}\n{}\n", model.name, a.method == "adaptive" ? "adaptive " + a.stepper : "rk4",
                                          a.method == "adaptive" ? fmt::format("tolerance {}", o.absolute_tolerance) : fmt::format("{} substep{} per sample", o.substeps, o.substeps == 1 ? "" : "s"),
                                          initial_text, summary.brief_report());
+  // The CSV is the result (stdout, or the file); the summary and `wrote` are about the run: stderr
+  // either way, so that `sidc simulate ... > run.csv` and `-o run.csv` give the same file.
+  std::cerr << report;
   if (a.out.empty()) {
     std::cout << csv;
-    std::cerr << report;
   } else {
     if (!write_file_atomically(a.out, csv, &error)) return fail(render(cli_diag::cannot_write(error)), exit_code::user_error);
-    std::cout << report << "wrote " << a.out << "\n";
+    std::cerr << "wrote " << a.out << "\n";
   }
   if (!summary.completed()) {
     return fail(render(cli_diag::simulation_stopped(summary.message)), exit_code::user_error);

@@ -1,6 +1,7 @@
 #include "compiler/declare_pass.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <fmt/format.h>
 
 #include "ir/settings.hpp"
@@ -30,6 +31,9 @@ struct Declarer {
   Declarations out;
   ir::IntegrationRequest current_integration;
   std::map<std::string, Span> set_once;  // global settings already seen
+  // The last `set form|integrate|constants` no equation has followed yet: it applies to the
+  // equations after it, so one after the last equation applies to nothing (a warning).
+  std::optional<std::pair<std::string, Span>> pending_equation_setting;
 
   Span span(const boost::spirit::x3::position_tagged& node) const { return parsed.span(node); }
 
@@ -170,6 +174,7 @@ struct Declarer {
       diagnostics.add(diag::bad_setting_value(value_span, key, s.value, problem.expected));
       return;
     }
+    if (key == "form" || key == "integrate" || key == "constants") pending_equation_setting.emplace(key, key_span);
     if (key == "form") {  // the same request as `integrate`, named by its form
       current_integration.span = value_span;
       request_form(current_integration, s.value);
@@ -220,14 +225,19 @@ struct Declarer {
     if (declare(p.name.name, span(p.name))) out.plots.push_back(&p);
   }
 
-  void operator()(const ast::Equation& e) { out.equations.push_back({&e, current_integration}); }
+  void operator()(const ast::Equation& e) {
+    out.equations.push_back({&e, current_integration});
+    pending_equation_setting.reset();
+  }
 };
 
 }  // namespace
 
 Declarations declare_pass(const ParseResult& parsed, Diagnostics& diagnostics) {
-  Declarer d{parsed, diagnostics, {}, {}, {}};
+  Declarer d{parsed, diagnostics, {}, {}, {}, {}};
   for (const auto& statement : parsed.model.statements) boost::apply_visitor(d, statement);
+  if (d.pending_equation_setting && !d.out.equations.empty())
+    diagnostics.add(diag::setting_after_last_equation(d.pending_equation_setting->second, d.pending_equation_setting->first));
 
   // Bindings name declared signals (or `t`), and not inputs given as expressions.
   auto signal_names = [&] {

@@ -409,6 +409,13 @@ struct Lowerer {
     return ir::number(Number::real(y), where);
   }
 
+  static bool mentions_time(const Sum& s) {
+    for (const auto& term : s.terms)
+      for (const auto& [f, power] : term.factors)
+        if (f.kind == FactorKind::time || f.kind == FactorKind::elapsed || (f.argument && mentions_time(*f.argument))) return true;
+    return false;
+  }
+
   Sum initial_value(const ast::Call& c, ir::Signal& s, int order) {
     const Span where = span(c);
     if (c.arguments.size() != 1) {
@@ -421,12 +428,14 @@ struct Lowerer {
     const auto* variable = arg.rest.empty() ? boost::get<ast::Variable>(&arg.first.get()) : nullptr;
     if (!(variable && variable->name.name == "t0" && variable->primes.empty())) {
       const Context saved = context;
-      context = Context{false, false, false, "the time of an initial value", {}};
+      // Time is let through here only to recognise a delay, `u(t - 0.05)`, and say so.
+      context = Context{false, false, true, "the time of an initial value", {}};
       Sum at = lower(arg);
       context = saved;
       auto n = at.as_number();
       if (failed || !n) {
-        if (!failed) report(diag::bad_initial_value(where, s.name));
+        if (!failed && mentions_time(at)) report(diag::delay_not_supported(where, s.name));
+        else if (!failed) report(diag::bad_initial_value(where, s.name));
         return {};
       }
       f.at = *n;

@@ -1,5 +1,6 @@
 #include "diagnostics/cli_catalogue.hpp"
 
+#include <cctype>
 #include <fmt/format.h>
 
 #include "diagnostics/model_catalogue.hpp"
@@ -71,8 +72,28 @@ Diagnostic no_compiled_model() {
                  "run `sidc compile model.sid` first, or name one: `sidc fit model.sidc.json`");
 }
 
-Diagnostic fitting_most_recent(std::string_view path) {
-  return message("fitting-most-recent", fmt::format("fitting `{}`, the most recently compiled model here", path), {}, Severity::note);
+Diagnostic several_compiled_models(const std::vector<std::string>& names) {
+  std::string list;
+  for (const auto& n : names) list += fmt::format("{}`{}`", list.empty() ? "" : ", ", n);
+  return message("several-compiled-models", fmt::format("{} compiled models in this directory ({}), and none named", names.size(), list),
+                 fmt::format("name the one to fit: `sidc fit {}`", names.front()));
+}
+
+Diagnostic output_not_writable(std::string_view option, std::string_view path, std::string_view reason) {
+  return message("output-not-writable", fmt::format("`{} {}` cannot be written: {}", option, path, reason),
+                 "choose a writable place; nothing was done, so nothing is lost");
+}
+
+Diagnostic unknown_subcommand(std::string_view name, std::string_view nearest, std::string_view names) {
+  return message("unknown-subcommand", fmt::format("unknown subcommand `{}`", name),
+                 nearest.empty() ? fmt::format("the subcommands are: {} (`sidc --help` says what each does)", names)
+                                 : fmt::format("did you mean `{}`? (the subcommands are: {})", nearest, names));
+}
+
+Diagnostic usage(std::string_view what, std::string_view command) {
+  std::string text(what);
+  if (!text.empty()) text[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(text[0])));
+  return message("usage", text, fmt::format("`{} --help` lists the {}", command, command == "sidc" ? "subcommands" : "options"));
 }
 
 Diagnostic compiled_model_not_json(std::string_view path) {
@@ -131,6 +152,11 @@ Diagnostic initial_order_too_high(std::string_view text, std::string_view name, 
                  "drop this initial condition");
 }
 
+Diagnostic record_as_model(std::string_view path) {
+  return message("record-as-model", fmt::format("`{}` is a record, but it stands where `sidc fit` expects a model", path),
+                 "`--data` takes one file: give each record its own, `--data a.csv --data b.csv`, then the model");
+}
+
 Diagnostic cannot_validate(std::string_view record, const Diagnostic& why) {
   return message("cannot-validate", fmt::format("cannot validate against `{}`: {}", record, render(why)));
 }
@@ -150,6 +176,16 @@ Diagnostic instrumental_variables_not_converged(std::string_view statement) {
 Diagnostic pictures_of_several_models(std::size_t models) {
   return message("pictures-of-several-models", fmt::format("--plots and --report draw one model's fit, and {} models were given", models),
                  "fit the models together for the comparison table, and each alone with --plots or --report");
+}
+
+Diagnostic cannot_export(std::string_view why) {
+  return message("cannot-export", fmt::format("cannot export the fitted model: {}", why),
+                 "`--as latex` writes any model; C and Python need equations that code alone can evaluate");
+}
+
+Diagnostic fit_file_without_model(std::string_view path) {
+  return message("fit-file-without-model", fmt::format("`{}` does not hold the model's text (it was written by an older sidc)", path),
+                 "fit the model again with `sidc fit MODEL --out DIR` and export DIR/fit.json");
 }
 
 Diagnostic required_and_dropped(std::string_view name) {

@@ -33,10 +33,20 @@ Diagnostic invalid_compiled_model(std::string_view path, std::string_view what);
 Diagnostic cannot_draw_figure(std::string_view figure, std::string_view why);
 Diagnostic cannot_read_back_figure(std::string_view figure, std::string_view why);
 Diagnostic no_compiled_model();
-Diagnostic fitting_most_recent(std::string_view path);
+// `sidc fit` without a model, and several compiled models here: which one is not guessed.
+Diagnostic several_compiled_models(const std::vector<std::string>& names);
 Diagnostic compiled_model_not_json(std::string_view path);
 Diagnostic model_changed_since_compiled(std::string_view model, std::string_view compiled);
 Diagnostic not_a_fit_file(std::string_view path);
+
+// An output named on the command line that cannot be written, found before any work is done.
+Diagnostic output_not_writable(std::string_view option, std::string_view path, std::string_view reason);
+
+// ---- the command line as a whole ---------------------------------------------------------------
+// `sidc fitt`: `nearest` is the closest subcommand ("" when none is close), `names` all of them.
+Diagnostic unknown_subcommand(std::string_view name, std::string_view nearest, std::string_view names);
+// A usage error found by the option parser (CLI11): its sentence, and where to read the options.
+Diagnostic usage(std::string_view what, std::string_view command);
 
 // ---- options -----------------------------------------------------------------------------------
 // An option's own check failed; `why` says how (from an options struct's is_valid()).
@@ -52,12 +62,20 @@ Diagnostic not_an_output(std::string_view text, std::string_view name);
 Diagnostic initial_order_too_high(std::string_view text, std::string_view name, int order);
 
 // ---- sidc fit ----------------------------------------------------------------------------------
+// A record (.csv) where a model belongs: `sidc fit --data a.csv b.csv model.sid`.
+Diagnostic record_as_model(std::string_view path);
 Diagnostic cannot_validate(std::string_view record, const Diagnostic& why);
 Diagnostic rank_deficient();
 Diagnostic pictures_of_several_models(std::size_t models);
 // A warning: the instrumental-variable iteration (`--estimator iv`) did not converge; `statement`
 // says what happened and which estimate is kept (runtime/solve/instrumental_variables.hpp).
 Diagnostic instrumental_variables_not_converged(std::string_view statement);
+
+// ---- sidc export -------------------------------------------------------------------------------
+// The fitted model cannot be written as code: `why` says what stands in the way.
+Diagnostic cannot_export(std::string_view why);
+// A fit.json from before fit.json carried the model's text.
+Diagnostic fit_file_without_model(std::string_view path);
 
 // ---- sidc select -------------------------------------------------------------------------------
 Diagnostic required_and_dropped(std::string_view name);

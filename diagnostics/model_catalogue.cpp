@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <map>
 
 namespace sidc::diag {
 namespace {
@@ -191,8 +192,21 @@ Diagnostic unknown_name(const Span& where, std::string_view name, std::string_vi
 }
 
 Diagnostic unknown_function(const Span& where, std::string_view name, std::string_view nearest) {
+  // A function of the usual maths library that sidc lacks is no typo of the one it is near
+  // (`sinh` is not a misspelt `sin`): the list, and how to write it from the ones there are.
+  static const std::map<std::string_view, std::string_view> rewrites{
+      {"sinh", "sinh(x) = (exp(x) - exp(-x))/2"}, {"cosh", "cosh(x) = (exp(x) + exp(-x))/2"}, {"tan", "tan(x) = sin(x)/cos(x)"},
+      {"cot", "cot(x) = cos(x)/sin(x)"},          {"sec", "sec(x) = 1/cos(x)"},                {"csc", "csc(x) = 1/sin(x)"},
+      {"log10", "log10(x) = log(x)/log(10)"},     {"log2", "log2(x) = log(x)/log(2)"},         {"exp2", "exp2(x) = exp(x*log(2))"},
+      {"pow", "pow(x, k) = x^k"},                 {"cbrt", "cbrt(x) = x^(1/3)"},               {"sqr", "sqr(x) = x^2"},
+      {"asin", ""}, {"acos", ""}, {"atan", ""}, {"atan2", ""}, {"asinh", ""}, {"acosh", ""}, {"atanh", ""},
+      {"floor", ""}, {"ceil", ""}, {"round", ""}, {"min", ""}, {"max", ""}, {"erf", ""}, {"gamma", ""}};
   std::string hint = did_you_mean(nearest);
-  if (hint.empty()) hint = "the functions are sin, cos, exp, log, sqrt, abs, sign, tanh, der and int";
+  const char* list = "the functions are sin, cos, exp, log, sqrt, abs, sign, tanh, der and int";
+  if (auto it = rewrites.find(name); it != rewrites.end())
+    hint = it->second.empty() ? fmt::format("{}; `{}` is not one of them", list, name)
+                              : fmt::format("{}; write `{}` with them: {}", list, name, it->second);
+  if (hint.empty()) hint = list;
   return error("unknown-function", where, fmt::format("unknown function `{}`", name), hint);
 }
 
@@ -275,6 +289,13 @@ Diagnostic setting_repeated(const Span& where, std::string_view key, const Span&
                fmt::format("it was first set on {}; keep one (command-line options override the file)", line_of(first)));
 }
 
+Diagnostic setting_after_last_equation(const Span& where, std::string_view key) {
+  Diagnostic d = error("setting-after-last-equation", where, fmt::format("`set {}` comes after the last equation and applies to nothing", key),
+                       fmt::format("`set {}` applies to the equations after it: move it above the equation(s) it is meant for", key));
+  d.severity = Severity::warning;
+  return d;
+}
+
 Diagnostic not_a_family(const Span& where, std::string_view name, bool is_signal) {
   return error("not-a-family", where, fmt::format("`{}` is not an indexed parameter family", name),
                is_signal ? fmt::format("`{0}` is a signal; to multiply it by a guard write `{0}*[...]`", name)
@@ -313,6 +334,12 @@ Diagnostic index_shadows(const Span& where, std::string_view name) {
 Diagnostic bad_initial_value(const Span& where, std::string_view signal) {
   return error("bad-initial-value", where, fmt::format("the initial value `{}(...)` needs one time: a number or `t0`", signal),
                fmt::format("write `{}(0)` for the record's value at t = 0, or `{}(t0)` at the start of the fit window", signal, signal));
+}
+
+Diagnostic delay_not_supported(const Span& where, std::string_view signal) {
+  return error("delay-not-supported", where, fmt::format("`{}` at a time that moves with t is a delay, which sidc does not support", signal),
+               fmt::format("shift the record's column by the delay and bind the shifted one (`data \"r.csv\" ({0} = \"{0}_delayed\")`); "
+                           "`{0}(0)` and `{0}(t0)` are values at a fixed time", signal));
 }
 
 Diagnostic not_callable(const Span& where, std::string_view name, std::string_view what) {

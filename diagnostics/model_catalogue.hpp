@@ -107,6 +107,8 @@ Diagnostic dependent_operations(const Span& where, std::string_view first, std::
 Diagnostic unknown_setting(const Span& where, std::string_view key, std::string_view nearest);
 Diagnostic bad_setting_value(const Span& where, std::string_view key, std::string_view value, std::string_view expected);
 Diagnostic setting_repeated(const Span& where, std::string_view key, const Span& first);
+// A warning: `set form|integrate|constants` applies to the equations after it, and none follows.
+Diagnostic setting_after_last_equation(const Span& where, std::string_view key);
 Diagnostic not_a_family(const Span& where, std::string_view name, bool is_signal);
 Diagnostic family_needs_index(const Span& where, std::string_view name);
 Diagnostic index_out_of_range(const Span& where, std::string_view family, long long index, int from, int to);
@@ -115,6 +117,8 @@ Diagnostic bad_range(const Span& where, int from, int to);
 Diagnostic range_too_large(const Span& where, long long count, int limit);
 Diagnostic index_shadows(const Span& where, std::string_view name);
 Diagnostic bad_initial_value(const Span& where, std::string_view signal);
+// `u(t - 0.05)`: a signal at a time that moves with t, a delay, which the linear form cannot hold.
+Diagnostic delay_not_supported(const Span& where, std::string_view signal);
 Diagnostic not_callable(const Span& where, std::string_view name, std::string_view what);
 Diagnostic bad_derivative_order(const Span& where);
 Diagnostic exponent_not_constant(const Span& where);

@@ -46,6 +46,9 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
   j["model"] = m.name;
   j["compiled_model"] = compiled_path;
   j["source_hash"] = source_hash(c.source->text);
+  // The model's text itself, so that `sidc export fit.json` needs nothing else to write the
+  // fitted equations as code.
+  j["model_source"] = c.source->text;
   const ordered_json derivative = o.evaluation.automatic_derivative
                                       ? ordered_json{{"window", "auto"}, {"order", "auto"}}
                                       : ordered_json{{"window", o.evaluation.derivative.window}, {"order", o.evaluation.derivative.polyorder}};
@@ -75,6 +78,19 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
       if (const int k = m.parameter_index(p.name); k >= 0 && m.parameters[static_cast<std::size_t>(k)].unit)
         parameters.back()["unit"] = to_string(*m.parameters[static_cast<std::size_t>(k)].unit);
     }
+    // The parameters' covariance sigma^2 (R^T R)^-1 (MATLAB's getcov) and its correlation, in
+    // the order of `parameters`; a parameter that is not estimable has NaN in its row and column.
+    ordered_json covariance = ordered_json::array(), correlation = ordered_json::array();
+    const auto& cov = ls.covariance;
+    for (Eigen::Index a = 0; a < cov.rows(); ++a) {
+      ordered_json cov_row = ordered_json::array(), corr_row = ordered_json::array();
+      for (Eigen::Index b = 0; b < cov.cols(); ++b) {
+        cov_row.push_back(cov(a, b));
+        corr_row.push_back(a == b && std::isfinite(cov(a, a)) && cov(a, a) > 0 ? 1.0 : cov(a, b) / std::sqrt(cov(a, a) * cov(b, b)));
+      }
+      covariance.push_back(std::move(cov_row));
+      correlation.push_back(std::move(corr_row));
+    }
     ordered_json regions = ordered_json::array();
     for (const auto& r : g.regions) regions.push_back({{"guards", r.guards}, {"rows", r.rows}});
     ordered_json dependent = ordered_json::array();
@@ -84,6 +100,7 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
       drift.push_back({{"equation", d.equation + 1}, {"what", d.what}, {"operation", d.operation}, {"record", d.record},
                        {"degree", d.degree}, {"share", d.share}});
     groups.push_back({{"equations", equations}, {"records", records}, {"regions", regions}, {"parameters", parameters},
+                      {"covariance", covariance}, {"correlation", correlation},
                       {"statistics", {{"n", ls.n}, {"p", ls.p}, {"rank", ls.rank}, {"G", ls.G}, {"standard_error", ls.standard_error},
                                       {"residual_sd", ls.residual_sd}, {"r_squared", ls.r_squared},
                                       {"r_squared_uncentred", ls.uncentred_r_squared}, {"r_squared_centred", ls.centred_r_squared}, {"aic", ls.aic}, {"bic", ls.bic},
@@ -154,13 +171,14 @@ nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSu
           {"groups", std::move(groups)}};
 }
 
-nlohmann::ordered_json validation_json(const FitValidation& v) {
+nlohmann::ordered_json validation_json(const FitValidation& v, std::size_t fitted_records) {
   using nlohmann::ordered_json;
   ordered_json j;
   j["method"] = v.method;
   j["note"] = v.note.empty() ? ordered_json(nullptr) : ordered_json(v.note);
   ordered_json runs = ordered_json::array();
-  for (const auto& run : v.runs) {
+  for (std::size_t i = 0; i < v.runs.size(); ++i) {
+    const auto& run = v.runs[i];
     ordered_json outputs = ordered_json::array(), verdict = ordered_json::array();
     auto optional = [](const std::optional<double>& x) { return x ? ordered_json(*x) : ordered_json(nullptr); };
     for (const auto& r : run.outputs) {
@@ -175,7 +193,7 @@ nlohmann::ordered_json validation_json(const FitValidation& v) {
       return o;
     };
     const bool estimated = run.initial_method == InitialState::estimate && run.start_segment > 0;
-    runs.push_back({{"record", run.record}, {"completed", run.simulation.completed()},
+    runs.push_back({{"record", run.record}, {"held_out", i >= fitted_records}, {"completed", run.simulation.completed()},
                     {"stopped_at", optional(run.simulation.stopped_at)},
                     {"statement", run.statement},
                     {"verdict", {{"follows", run.follows}, {"threshold_fit_percent", kFollowsFitPercent}, {"departure_share", kDepartureShare},
@@ -201,6 +219,16 @@ std::string validation_csv(const FitValidation& v) {
       out += "\n";
     }
   return out;
+}
+
+void non_finite_as_strings(nlohmann::ordered_json& j) {
+  if (j.is_number_float()) {
+    const double v = j.get<double>();
+    if (std::isnan(v)) j = "nan";
+    else if (std::isinf(v)) j = v > 0 ? "inf" : "-inf";
+  } else if (j.is_structured()) {
+    for (auto& child : j) non_finite_as_strings(child);
+  }
 }
 
 namespace {
@@ -245,7 +273,7 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   const std::string& csv_path = paths[1];
   const std::string& validation_path = paths[2];
   auto json = fit_json(f.summary, f.compiled, f.compiled_path, f.options);
-  if (f.validation) json["validation"] = validation_json(*f.validation);
+  if (f.validation) json["validation"] = validation_json(*f.validation, f.records.size());
   json["residual_analysis"] = residual_json(f.residuals);
   nlohmann::ordered_json choice;  // null unless the form was chosen from the data
   if (f.form_choice) {
@@ -263,6 +291,7 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   std::string why;
   std::optional<Diagnostic> problem;  // why the residual rows could not be had
   const ir::Model& model = f.compiled.integrated;
+  non_finite_as_strings(json);
   // One set, renamed in together once every file is whole: a failure leaves the previous run's
   // files as they were, and a validation.csv this run does not write is removed with the commit
   // (it would read as this fit's).
@@ -330,7 +359,9 @@ std::variant<std::string, Diagnostic> write_select_file(const std::string& direc
   if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
   const std::string path = select_file_path(directory);
   std::string why;
-  if (!write_file_atomically(path, select_json(summary, model_path, options).dump(1) + "\n", &why)) return cli_diag::cannot_write(why);
+  auto json = select_json(summary, model_path, options);
+  non_finite_as_strings(json);
+  if (!write_file_atomically(path, json.dump(1) + "\n", &why)) return cli_diag::cannot_write(why);
   return path;
 }
 

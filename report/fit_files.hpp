@@ -26,11 +26,18 @@
 namespace sidc {
 
 nlohmann::ordered_json fit_json(const FitSummary& summary, const CompiledModel& compiled, const std::string& compiled_path, const FitOptions& options);
-nlohmann::ordered_json validation_json(const FitValidation& validation);
+// `fitted_records`: the runs past them are of held-out records (`held_out`: true).
+nlohmann::ordered_json validation_json(const FitValidation& validation, std::size_t fitted_records);
 nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis);
 nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSummary& iv);
 // record,t, then per output: recorded, simulated, error; "" when nothing was simulated.
 std::string validation_csv(const FitValidation& validation);
+
+// JSON has no infinity or NaN, and nlohmann writes them as null, which reads back as "absent".
+// fit.json and select.json write them as the strings "inf", "-inf" and "nan" instead (docs/cli.md):
+// every double of `j` that is not finite is replaced so, in place. A field that is null by design
+// ("not computed") stays null.
+void non_finite_as_strings(nlohmann::ordered_json& j);
 
 struct FitFiles {
   const CompiledModel& compiled;

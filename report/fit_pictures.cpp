@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <set>
+#include <fstream>
 #include <fmt/format.h>
 #include <limits>
 #include <map>
 #include <memory>
 
 #include "diagnostics/cli_catalogue.hpp"
+#include "report/atomic_file.hpp"
 #include "ir/print.hpp"
 #include "ir/traversal.hpp"
 #include "report/fit_figures.hpp"
@@ -125,6 +128,9 @@ struct NamedFigure {
   int group = -1;  // the equation group it belongs to in the report; -1: the whole fit
 };
 
+// A record as titles name it: its file name (the folder is in the report's record table).
+std::string record_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
 std::vector<NamedFigure> fit_figures(const PictureContext& c) {
   std::vector<NamedFigure> figures;
   const ir::Model& model = c.compiled.integrated;
@@ -141,6 +147,10 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
       Figure b = simulation_error_figure(time, output, run.simulation.time, run.recorded[o], run.simulated[o]);
       const std::string s = c.validations.size() > 1 ? fmt::format("_r{}", v + 1) : std::string();
       a.name += s, b.name += s;
+      // Which record: with several, `_r2` alone does not say; a held-out one is the test on new data.
+      const std::string which = v >= c.records.size() ? fmt::format(", held-out record {} (--validate, not fitted)", record_name(run.record))
+                                                      : fmt::format(", record {}", record_name(run.record));
+      a.title += which, b.title += which;
       figures.push_back({std::move(a)}), figures.push_back({std::move(b)});
     }
   }
@@ -188,6 +198,7 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
         const std::string setting = fmt::format("Delta = {:g}, {}", record.step, estimates.arc_of(signal, comparisons.front().order));
         Figure f = derivative_error_figure(time, {signal, ""}, at, comparisons, setting);
         f.name += suffix(r);
+        f.title += ", record " + record_name(record.path);
         figures.push_back({std::move(f)});
       }
     }
@@ -199,6 +210,7 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
       if (!y || !y_dot) continue;
       Figure f = phase_plane_figure({s.name, ""}, "s", y->values, y_dot->values);
       f.name += suffix(r);
+      f.title += ", record " + record_name(record.path);
       figures.push_back({std::move(f)});
     }
   }
@@ -238,6 +250,8 @@ ReportContent report_content(const PictureContext& c) {
                                  c.options.to ? fmt::format("{:g}", *c.options.to) : std::string("its end"))},
   };
   for (const auto& r : c.records) content.records.push_back(fmt::format("{} ({} samples, step {:g})", r.path, r.time.size(), r.step));
+  for (std::size_t v = c.records.size(); v < c.validations.size(); ++v)
+    content.records.push_back(fmt::format("{} (held out: --validate, compared with the solved equations, not fitted)", c.validations[v].record));
   for (std::size_t g = 0; g < c.summary.groups.size(); ++g) {
     const GroupFit& group = c.summary.groups[g];
     ReportGroup out;
@@ -252,14 +266,39 @@ ReportContent report_content(const PictureContext& c) {
   }
   // The simulation covers every output at once: its table goes with the first group.
   if (!content.groups.empty()) {
-    for (const auto& run : c.validations)
+    for (std::size_t v = 0; v < c.validations.size(); ++v) {
+      const ValidationSummary& run = c.validations[v];
+      const std::string record = v >= c.records.size() ? run.record + " (held out)" : run.record;
       for (const auto& o : run.outputs)
-        content.groups.front().validation.push_back({o.output, run.record, o.max_abs_error, o.percent_error, o.fit_percent,
+        content.groups.front().validation.push_back({o.output, record, o.max_abs_error, o.percent_error, o.fit_percent,
                                                      run.simulation.completed() ? std::string() : run.statement});
+    }
   }
   if (!c.validation_note.empty()) content.notes.push_back("Validation by simulation " + c.validation_note);
   content.generated_by = fmt::format("sidc {}", SIDC_VERSION);
   return content;
+}
+
+// The folder holds this run's pictures only: those an earlier run listed in its manifest
+// (kPictureManifest) and this run did not draw again are removed. Only names sidc wrote there, as
+// the manifest lists them, plain file names ending in .svg or .png; a user's own files are never
+// touched. Then the manifest lists this run's. A manifest that cannot be written costs nothing
+// but the next run's cleaning.
+constexpr const char* kPictureManifest = ".sidc-pictures";
+
+void forget_stale_pictures(const fs::path& directory, const std::vector<std::string>& drawn) {
+  std::set<std::string> now;
+  for (const auto& f : drawn) now.insert(fs::path(f).filename().string());
+  std::ifstream before(directory / kPictureManifest);
+  std::error_code ec;
+  for (std::string name; std::getline(before, name);) {
+    const bool picture = name.ends_with(".svg") || name.ends_with(".png");
+    if (picture && name.find('/') == std::string::npos && name[0] != '.' && !now.count(name)) fs::remove(directory / name, ec);
+  }
+  std::string list;
+  for (const auto& name : now) list += name + "\n";
+  std::string why;
+  write_file_atomically((directory / kPictureManifest).string(), list, &why);
 }
 
 }  // namespace
@@ -317,6 +356,7 @@ bool write_fit_pictures(const PictureContext& context, const PictureRequest& req
     for (const auto& f : drawn) fs::remove(f, ec);  // no half set of pictures
   } else {
     written.insert(written.end(), drawn.begin(), drawn.end());
+    forget_stale_pictures(directory, drawn);
   }
   return ok;
 }

@@ -33,11 +33,17 @@ th { background: #eee; }
 td.name, th.name { text-align: left; font-family: "DejaVu Sans Mono", monospace; }
 .verdict { font-style: italic; }
 .figures { display: flex; flex-wrap: wrap; gap: 0.5em; }
-figure { margin: 0; flex: 1 1 45%; min-width: 80mm; break-inside: avoid; page-break-inside: avoid; }
+figure { margin: 0; flex: 1 1 100%; break-inside: avoid; page-break-inside: avoid; }
 figure svg { width: 100%; height: auto; display: block; }
 figcaption { font-size: 8.5pt; color: #333; }
+figcaption a { margin-left: 0.5em; }
+figure:target { position: fixed; inset: 0; z-index: 10; background: #fff; padding: 1em; overflow: auto; }
+figure:target svg { max-height: 90vh; }
+figure .close { display: none; }
+figure:target .close { display: inline; }
+figure:target .enlarge { display: none; }
 @page { size: A4; margin: 15mm; }
-@media print { body { margin: 0; max-width: none; } h2 { break-after: avoid; } }
+@media print { body { margin: 0; max-width: none; } h2 { break-after: avoid; } figcaption a { display: none; } }
 )css";
 
 void figures_html(const std::vector<ReportFigure>& figures, std::size_t* counter, std::string& out) {
@@ -45,9 +51,13 @@ void figures_html(const std::vector<ReportFigure>& figures, std::size_t* counter
   out += "<div class=\"figures\">\n";
   for (const auto& figure : figures) {
     const std::string svg = inline_svg(figure.svg, fmt::format("f{}-", ++*counter));
-    out += "<figure>\n";
-    out += svg.empty() ? "<p>(picture not available)</p>\n" : svg + "\n";
-    out += "<figcaption>" + html_escape(figure.caption) + "</figcaption>\n</figure>\n";
+    // Full column width, and a click shows it over the whole window (CSS :target; no script, so
+    // the page stays self-contained).
+    const std::string id = fmt::format("figure-{}", *counter);
+    out += "<figure id=\"" + id + "\">\n";
+    out += svg.empty() ? "<p>(picture not available)</p>\n" : "<a href=\"#" + id + "\">" + svg + "</a>\n";
+    out += "<figcaption>" + html_escape(figure.caption) + "<a class=\"enlarge\" href=\"#" + id + "\">enlarge</a><a class=\"close\" href=\"#\">close</a>" +
+           "</figcaption>\n</figure>\n";
   }
   out += "</div>\n";
 }

@@ -40,11 +40,14 @@ std::string operator_report(const std::vector<OperatorReport>& reports, const Ev
   return out;
 }
 
-std::string validation_report(const FitValidation& v) {
+std::string validation_report(const FitValidation& v, std::size_t fitted_records) {
   std::string out;
   if (!v.note.empty()) out += "\nvalidation: " + v.note + "\n";
-  for (const auto& run : v.runs) {
-    out += "\n" + run.report(v.method);
+  for (std::size_t i = 0; i < v.runs.size(); ++i) {
+    const auto& run = v.runs[i];
+    out += "\n";
+    if (i >= fitted_records) out += fmt::format("held-out record `{}` (--validate): not used in fitting, so this is a test on new data\n", run.record);
+    out += run.report(v.method);
     if (run.truncated)
       out += fmt::format("  (the first {} samples only: --validate-samples N compares more, 0 all; about 16 equation evaluations a sample)\n",
                          v.max_samples);

@@ -13,7 +13,9 @@ namespace sidc {
 // Per record: each signal's noise level (noise_level.hpp) and the derivative operators, chosen
 // by savgol(auto) with their estimated rms errors, or the one the settings name.
 std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options);
-std::string validation_report(const FitValidation& validation);
+// `fitted_records`: how many of the runs are of fitted records; the rest are held out
+// (`--validate`), and each is marked so.
+std::string validation_report(const FitValidation& validation, std::size_t fitted_records);
 std::string residual_report(const ResidualAnalysis& analysis);
 std::string comparison_table(const ModelComparison& comparison);
 

@@ -20,7 +20,8 @@ fuzzer=$1 kind=$2 seconds=$3 work_dir=$4 sidc=${5:-}
 repo_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 
 seeds=$work_dir/seeds
-rm -rf "$seeds"
+# Compiled seeds cost a compile each: made once per build tree (the stamp), the others every run.
+[[ $kind == compiled && -e $seeds/.complete ]] || rm -rf "$seeds"
 mkdir -p "$seeds" "$work_dir/corpus" "$work_dir/findings"
 
 # One seed per file, named after its path so that collisions cannot hide one.
@@ -33,14 +34,16 @@ case "$kind" in
     if [[ $kind == model ]]; then
       for m in "${models[@]}"; do add_seed "$m"; done
       max_len=8192
-    else
+    elif [[ ! -e $seeds/.complete ]]; then
       [[ -x $sidc ]] || { echo "run_fuzz.sh: compiled seeds need the sidc binary as 5th argument" >&2; exit 2; }
-      for m in "${models[@]}"; do  # the models that compile; the others are the bad-input catalogue
+      for m in "${models[@]}"; do  # the models that compile: the bad-input catalogue does not
+        [[ $m == */bad*/* ]] && continue
         out=$seeds/$(echo "${m#"$repo_root"/}" | tr '/' '_').sidc.json
         "$sidc" compile "$m" -o "$out" >/dev/null 2>&1 || rm -f "$out"
       done
-      max_len=65536
-    fi ;;
+      touch "$seeds/.complete"
+    fi
+    if [[ $kind == compiled ]]; then max_len=65536; fi ;;
   csv)
     mapfile -t records < <(find "$repo_root/examples" "$repo_root/tests" \( -name '*.csv' -o -name '*.tsv' \) \
                              -size -16k | sort)
@@ -53,7 +56,7 @@ case "$kind" in
     max_len=16384 ;;
   *) echo "run_fuzz.sh: unknown kind '$kind' (model, compiled or csv)" >&2; exit 2 ;;
 esac
-echo "run_fuzz.sh: $(basename "$fuzzer"): $(find "$seeds" -type f | wc -l) seeds, $seconds s"
+echo "run_fuzz.sh: $(basename "$fuzzer"): $(find "$seeds" -type f -not -name .complete | wc -l) seeds, $seconds s"
 
 # -timeout: one input taking 25 s is a hang; -rss_limit_mb: more than 2 GB is a finding too.
 status=0

@@ -584,13 +584,13 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
   }
   const bool centred_r2 = options.intercept_in_r2 && constant_column >= 0;
   summary.r_squared_centred = centred_r2;
-  double total_centred = 0, total_uncentred = 0;  // sum w^2 (b - ybar_w)^2 and sum (w b)^2
+  Ext total_centred = 0, total_uncentred = 0;  // sum w^2 (b - ybar_w)^2 and sum (w b)^2
   if (streamed) {
     G += Ext(streamed->residual_sum_of_squares);
-    total_centred = streamed->total_centred;
-    total_uncentred = streamed->total_uncentred;
-    const double total = centred_r2 ? total_centred : total_uncentred;
-    summary.r_squared = total > 0 ? 1.0 - to_double(G) / total : kNaN;
+    total_centred = Ext(streamed->total_centred);
+    total_uncentred = Ext(streamed->total_uncentred);
+    const Ext total = centred_r2 ? total_centred : total_uncentred;
+    summary.r_squared = total > Ext(0) ? to_double(Ext(1) - G / total) : kNaN;
   } else {
     const Ext mean = weight_sum > 0 ? weighted_b_sum / weight_sum : Ext(0);
     Ext explained = 0, centred = 0, uncentred = 0;
@@ -602,11 +602,11 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
       uncentred += (w * Ext(rows.b(i))) * (w * Ext(rows.b(i)));
     }
     summary.r_squared = explained + G > 0 ? to_double(explained / (explained + G)) : kNaN;
-    total_centred = to_double(centred);
-    total_uncentred = to_double(uncentred);
+    total_centred = centred;
+    total_uncentred = uncentred;
   }
   // The one not chosen as r_squared, as 1 - G / TSS (the chosen one keeps its SSR / (SSR + G) digits).
-  const auto one_minus = [&](double total) { return total > 0 ? 1.0 - to_double(G) / total : kNaN; };
+  const auto one_minus = [&](Ext total) { return total > Ext(0) ? to_double(Ext(1) - G / total) : kNaN; };
   summary.centred_r_squared = centred_r2 ? summary.r_squared : one_minus(total_centred);
   summary.uncentred_r_squared = centred_r2 ? one_minus(total_uncentred) : summary.r_squared;
   summary.G = to_double(G);

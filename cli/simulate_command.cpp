@@ -123,7 +123,7 @@ std::variant<std::map<std::string, std::vector<std::optional<double>>>, Failure>
     auto [name, v] = std::get<std::pair<std::string, double>>(parsed);
     int order = 0;
     while (!name.empty() && name.back() == '\'') name.pop_back(), ++order;
-    const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&](const auto& o) { return o.name == name; });
+    const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&output_name = name](const auto& o) { return o.name == output_name; });
     if (out == form.outputs.end())
       return Failure{exit_code::usage_error, render(cli_diag::not_an_output(text, name))};
     if (order >= out->order) return Failure{exit_code::usage_error, render(cli_diag::initial_order_too_high(text, name, out->order))};

@@ -642,4 +642,21 @@ Diagnostic drift_dominates(const Span& where, std::size_t number, int integratio
   return d;
 }
 
+Diagnostic known_side_zero(const Span& where, std::size_t number, std::string_view known, std::string_view records) {
+  return error("known-side-zero", where,
+               fmt::format("the known side `{}` of equation {} is zero on every row of {}: every parameter would be 0 and the fit "
+                           "statistics meaningless",
+                           known, number, records),
+               "check that the record's column holds the signal (not a column of zeros), or fit a record in which it varies");
+}
+
+Diagnostic statistics_not_finite(const Span& where, std::string_view equations, std::string_view statistics) {
+  Diagnostic d = error("statistics-not-finite", where,
+                       fmt::format("the fit of {} leaves {}", equations, statistics),
+                       "the other statistics are computed in extended precision and hold; for every number to fit in a double, give "
+                       "the record in units that keep its values between about 1e-150 and 1e150");
+  d.severity = Severity::warning;
+  return d;
+}
+
 }  // namespace sidc::diag

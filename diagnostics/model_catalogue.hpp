@@ -189,5 +189,12 @@ Diagnostic simulate_initial_value_term(const Span& where, std::string_view term)
 // `others` names further operations so dominated ("as is the operation of `k`"; may be empty).
 Diagnostic drift_dominates(const Span& where, std::size_t number, int integrations, std::string_view what, std::string_view record, double share,
                            std::string_view others);
+// ---- the fit's statistics (runtime/solve/fit.cpp) -----------------------------------------------
+// Equation `number` (1-based) has a known side `known` that is zero on every row of `records` (the
+// fitted records, named): every parameter would come out 0 with R^2 undefined.
+Diagnostic known_side_zero(const Span& where, std::size_t number, std::string_view known, std::string_view records);
+// A warning: the fit of `equations` ("equation 1", "equations 1 and 2") leaves `statistics` (from
+// unrepresentable_statistics, joined) non-finite or beyond a double.
+Diagnostic statistics_not_finite(const Span& where, std::string_view equations, std::string_view statistics);
 
 }  // namespace sidc::diag

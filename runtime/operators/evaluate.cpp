@@ -28,7 +28,6 @@ std::size_t index_at_or_after(const std::vector<double>& time, double t) {
 }  // namespace
 
 void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard) {
-  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < guard.size(); ++i) {
     if (std::isnan(lhs[i]) || std::isnan(rhs[i])) {
       guard[i] = nan;

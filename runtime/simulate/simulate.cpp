@@ -164,7 +164,7 @@ class System {
       const auto& [name, order] = layout_.slots()[s];
       Source source;
       source.slot = s;
-      const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&](const auto& x) { return x.name == name; });
+      const auto out = std::find_if(form.outputs.begin(), form.outputs.end(), [&slot_name = name](const auto& x) { return x.name == slot_name; });
       if (out != form.outputs.end()) {
         source.kind = Source::Kind::state;
         source.index = state_offset_[static_cast<std::size_t>(out - form.outputs.begin())] + static_cast<std::size_t>(order);

@@ -16,6 +16,7 @@
 
 #include <time.h>
 
+#include "diagnostics/model_catalogue.hpp"
 #include "ir/print.hpp"
 #include "ir/queries.hpp"
 #include "ir/traversal.hpp"
@@ -307,6 +308,26 @@ std::variant<std::vector<std::vector<double>>, Diagnostic> expression_weights_by
   return out;
 }
 
+// An equation whose known side is zero on every row of the group (a record column of zeros): least
+// squares would return every parameter 0 with G = 0, R^2 undefined and AIC = -inf, and call it a
+// fit. Refused, naming the equation and the records. Needs g.known and g.row_equation (dense, weak).
+std::optional<Diagnostic> zero_known_side(const ir::Model& model, const std::vector<SampledRecord>& records, const GroupFit& g) {
+  for (std::size_t e : g.equations) {
+    bool has_rows = false, non_zero = false;
+    for (std::size_t i = 0; i < g.known.size() && !non_zero; ++i) {
+      if (g.row_equation[i] != e) continue;
+      has_rows = true;
+      non_zero = g.known[i] != 0;
+    }
+    if (!has_rows || non_zero) continue;
+    std::string names;
+    for (std::size_t r = 0; r < records.size(); ++r)
+      names += fmt::format("{}`{}`", r == 0 ? "" : r + 1 == records.size() ? " and " : ", ", records[r].path);
+    return diag::known_side_zero(model.equations[e].span, e + 1, print(model.equations[e].known), names);
+  }
+  return std::nullopt;
+}
+
 // A group of weak-form equations (weak_design.hpp): always dense, one row per subdomain.
 std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vector<SampledRecord>& records,
                                          std::vector<Evaluator>& evaluators, const DesignBuilder& design, const FitOptions& options,
@@ -328,6 +349,7 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
   if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
   g.regions = std::get<std::vector<Region>>(std::move(regions));
   if (auto problem = design.too_few_rows(static_cast<std::size_t>(w.b.size()), options.evaluation)) return problem;
+  if (auto problem = zero_known_side(model, records, g)) return problem;
   g.summary = solve_least_squares(w.A, w.b, g.columns, g.weighted ? &w.weights : nullptr, options.least_squares);
   design.label(g.summary);
   return std::nullopt;
@@ -441,6 +463,7 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     if (auto* d = std::get_if<Diagnostic>(&regions)) return *d;
     g.regions = std::get<std::vector<Region>>(std::move(regions));
     if (auto problem = design.too_few_rows(total_rows, evaluation.front())) return *problem;
+    if (auto problem = zero_known_side(model, records, g)) return *problem;
     std::vector<std::string> paths;
     for (const auto& r : records) paths.push_back(r.path);
     g.drift = find_drift(model, members, g.columns, g.column_parameters, A, b, g.row_equation, g.row_record, g.row_time, paths);
@@ -507,6 +530,21 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
     }
   }
   return std::nullopt;
+}
+
+std::vector<Diagnostic> statistics_warnings(const ir::Model& model, const FitSummary& summary) {
+  std::vector<Diagnostic> warnings;
+  for (const GroupFit& g : summary.groups) {
+    const std::vector<std::string> found = unrepresentable_statistics(g.summary);
+    if (found.empty() || g.equations.empty()) continue;
+    std::string equations = g.equations.size() == 1 ? "equation " : "equations ";
+    for (std::size_t k = 0; k < g.equations.size(); ++k)
+      equations += fmt::format("{}{}", k == 0 ? "" : k + 1 == g.equations.size() ? " and " : ", ", g.equations[k] + 1);
+    std::string statistics;
+    for (std::size_t k = 0; k < found.size(); ++k) statistics += (k == 0 ? "" : ", ") + found[k];
+    warnings.push_back(diag::statistics_not_finite(model.equations[g.equations.front()].span, equations, statistics));
+  }
+  return warnings;
 }
 
 bool FitSummary::is_solution_usable() const {

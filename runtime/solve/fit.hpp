@@ -103,6 +103,10 @@ struct FitSummary {
 std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vector<SampledRecord>& records,
                                          const FitOptions& options);
 
+// A warning per group whose statistics are not finite or not representable in a double
+// (least_squares.hpp: unrepresentable_statistics), at its first equation.
+std::vector<Diagnostic> statistics_warnings(const ir::Model& model, const FitSummary& summary);
+
 // One row of a group's residuals: r_i = b_i - A_i x, unweighted (eq. 2-1.7 before weighting).
 struct ResidualRow {
   std::size_t equation = 0, record = 0;  // indices into the model's equations and the records

@@ -410,6 +410,17 @@ ConstantColumn constant_column_of(const Rows& rows) {
   return {};
 }
 
+// The power of two 2^-e that brings `norm` = m 2^e (m in [0.5, 1)) into [0.5, 1); 1 for a zero or
+// non-finite norm. e is kept where 2^-e is a normal double, so that the factor itself is finite and
+// exact: a column of subnormal numbers (norm below 2^-1022) is scaled by 2^1022 and stays small,
+// which the condition number then shows, rather than by an infinite factor that makes it NaN.
+double power_of_two_scale(double norm) {
+  if (!(norm > 0) || !std::isfinite(norm)) return 1.0;
+  int exponent = 0;
+  std::frexp(norm, &exponent);
+  return std::ldexp(1.0, std::clamp(-exponent, -1022, 1022));
+}
+
 // Step 2: the column transform. Centring first (it changes the norms), then scaling.
 ColumnTransform choose_transform(const Rows& rows, const LeastSquaresOptions& options, ConstantColumn constant) {
   const Index n = rows.n(), p = rows.p();
@@ -439,12 +450,7 @@ ColumnTransform choose_transform(const Rows& rows, const LeastSquaresOptions& op
         sum += entry * entry;
       }
       using std::sqrt;
-      const double norm = to_double(sqrt(sum));
-      if (norm > 0 && std::isfinite(norm)) {
-        int exponent = 0;
-        std::frexp(norm, &exponent);  // norm = m 2^exponent, m in [0.5, 1)
-        transform.scale[static_cast<std::size_t>(j)] = std::ldexp(1.0, -exponent);
-      }
+      transform.scale[static_cast<std::size_t>(j)] = power_of_two_scale(to_double(sqrt(sum)));
     }
   }
   return transform;
@@ -509,12 +515,23 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
       options.rank_tolerance > 0 ? options.rank_tolerance
                                  : DBL_EPSILON * static_cast<double>(std::max(n, p));
 
+  // The known side scaled like the columns (section 3-2): by the power of two that brings |w.*b| into
+  // [0.5, 1). The QR then sees numbers near 1 whatever the record's units, so data of 1e-300 or of
+  // subnormal size lose no digits to underflow in Q^T b; the parameters are divided by the same
+  // power of two afterwards, which is exact.
+  Ext known_squares = 0;
+  for (Index i = 0; i < rows.n(); ++i) known_squares += (Ext(rows.weight(i)) * Ext(rows.b(i))) * (Ext(rows.weight(i)) * Ext(rows.b(i)));
+  using std::sqrt;
+  const double known_scale = power_of_two_scale(to_double(sqrt(known_squares)));
+  const Eigen::VectorXd scaled_b = rows.b * known_scale;
+  const Rows scaled_rows{rows.A, scaled_b, rows.w};
+
   // Steps 3 and 4 in the chosen precision.
   const double work = static_cast<double>(rows.n()) * static_cast<double>(p) * static_cast<double>(p);
   const bool extended = options.precision == Precision::extended ||
                         (options.precision == Precision::automatic && work <= options.extended_work_limit);
-  const Attempt attempt = extended ? fit_in<Ext, QuadScalar>(rows, transform, rank_tolerance, options.refinement_steps)
-                                   : fit_in<double, Ext>(rows, transform, rank_tolerance, options.refinement_steps);
+  const Attempt attempt = extended ? fit_in<Ext, QuadScalar>(scaled_rows, transform, rank_tolerance, options.refinement_steps)
+                                   : fit_in<double, Ext>(scaled_rows, transform, rank_tolerance, options.refinement_steps);
   std::string arithmetic =
       extended ? fmt::format("QR in {} ({} bits), refinement residuals in {}", kExtendedName, mantissa_bits<Ext>(), kQuadName)
                : fmt::format("QR in double, refinement residuals in {} ({} bits)", kExtendedName, mantissa_bits<Ext>());
@@ -543,9 +560,13 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
     summary.dependent_groups.push_back(std::move(named));
   }
 
-  // Step 5: statistics of the reported parameters.
+  // Step 5: statistics of the reported parameters, against the original rows. Every sum of squares
+  // and everything derived from one stays in the extended type (exponents to about +-4900) until
+  // the end: a record of values near 1e200 or 1e-300 has G near 1e400 or 1e-600, beyond a double,
+  // while its standard errors, R^2, AIC and BIC are ordinary numbers. Only G itself may then not be
+  // representable (statistics_not_representable() names it).
   Eigen::VectorXd x(static_cast<Index>(p));
-  for (Index j = 0; j < x.size(); ++j) x(j) = attempt.x[static_cast<std::size_t>(j)];
+  for (Index j = 0; j < x.size(); ++j) x(j) = to_double(Ext(attempt.x[static_cast<std::size_t>(j)]) / Ext(known_scale));
   Ext G = 0, weight_sum = 0, weighted_b_sum = 0;
   const Index rows_n = rows.n();
   std::vector<Ext> fitted(static_cast<std::size_t>(rows_n));
@@ -563,13 +584,13 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
   }
   const bool centred_r2 = options.intercept_in_r2 && constant_column >= 0;
   summary.r_squared_centred = centred_r2;
-  double total_centred = 0, total_uncentred = 0;  // sum w^2 (b - ybar_w)^2 and sum (w b)^2
+  Ext total_centred = 0, total_uncentred = 0;  // sum w^2 (b - ybar_w)^2 and sum (w b)^2
   if (streamed) {
     G += Ext(streamed->residual_sum_of_squares);
-    total_centred = streamed->total_centred;
-    total_uncentred = streamed->total_uncentred;
-    const double total = centred_r2 ? total_centred : total_uncentred;
-    summary.r_squared = total > 0 ? 1.0 - to_double(G) / total : kNaN;
+    total_centred = Ext(streamed->total_centred);
+    total_uncentred = Ext(streamed->total_uncentred);
+    const Ext total = centred_r2 ? total_centred : total_uncentred;
+    summary.r_squared = total > Ext(0) ? to_double(Ext(1) - G / total) : kNaN;
   } else {
     const Ext mean = weight_sum > 0 ? weighted_b_sum / weight_sum : Ext(0);
     Ext explained = 0, centred = 0, uncentred = 0;
@@ -581,36 +602,42 @@ LeastSquaresSummary solve_rows(const Rows& rows, const std::vector<std::string>&
       uncentred += (w * Ext(rows.b(i))) * (w * Ext(rows.b(i)));
     }
     summary.r_squared = explained + G > 0 ? to_double(explained / (explained + G)) : kNaN;
-    total_centred = to_double(centred);
-    total_uncentred = to_double(uncentred);
+    total_centred = centred;
+    total_uncentred = uncentred;
   }
   // The one not chosen as r_squared, as 1 - G / TSS (the chosen one keeps its SSR / (SSR + G) digits).
-  const auto one_minus = [&](double total) { return total > 0 ? 1.0 - to_double(G) / total : kNaN; };
+  const auto one_minus = [&](Ext total) { return total > Ext(0) ? to_double(Ext(1) - G / total) : kNaN; };
   summary.centred_r_squared = centred_r2 ? summary.r_squared : one_minus(total_centred);
   summary.uncentred_r_squared = centred_r2 ? one_minus(total_uncentred) : summary.r_squared;
   summary.G = to_double(G);
+  using std::log;
   const double n_double = static_cast<double>(n);
   const double k = static_cast<double>(attempt.rank);
   const std::size_t dof = n - attempt.rank;
-  summary.standard_error = n > 0 ? std::sqrt(summary.G / n_double) : kNaN;  // Table 4-1.2
-  summary.residual_sd = dof > 0 ? std::sqrt(summary.G / static_cast<double>(dof)) : kNaN;
-  summary.aic = n_double * std::log(summary.G / n_double) + 2 * k;
-  summary.bic = n_double * std::log(summary.G / n_double) + k * std::log(n_double);
+  summary.standard_error = n > 0 ? to_double(sqrt(G / Ext(n_double))) : kNaN;  // Table 4-1.2
+  summary.residual_sd = dof > 0 ? to_double(sqrt(G / Ext(static_cast<double>(dof)))) : kNaN;
+  const double log_mean_square = n > 0 && G > Ext(0) ? to_double(log(G / Ext(n_double)))
+                                 : n > 0             ? -kInf
+                                                     : kNaN;
+  summary.aic = n_double * log_mean_square + 2 * k;
+  summary.bic = n_double * log_mean_square + k * std::log(n_double);
 
-  const double variance = dof > 0 ? summary.G / static_cast<double>(dof) : kNaN;
+  const Ext variance = dof > 0 ? G / Ext(static_cast<double>(dof)) : Ext(kNaN);
   const double t = t_quantile(0.5 + options.confidence_level / 2, static_cast<double>(dof));
   summary.covariance.resize(static_cast<Index>(p), static_cast<Index>(p));
   for (Index i = 0; i < summary.covariance.rows(); ++i) {
     for (Index j = 0; j < summary.covariance.cols(); ++j) {
-      summary.covariance(i, j) = to_double(attempt.covariance_unit(i, j) * Ext(variance));
+      summary.covariance(i, j) = to_double(attempt.covariance_unit(i, j) * variance);
     }
   }
   for (std::size_t j = 0; j < p; ++j) {
     ParameterEstimate estimate;
     estimate.name = names[j];
     estimate.value = x(static_cast<Index>(j));
-    const double diagonal = summary.covariance(static_cast<Index>(j), static_cast<Index>(j));
-    estimate.standard_error = attempt.dropped[j] || !(diagonal >= 0) ? kNaN : std::sqrt(diagonal);
+    // From the extended product: a covariance beyond a double (parameters near 1e200) still has
+    // a representable square root.
+    const Ext diagonal = attempt.covariance_unit(static_cast<Index>(j), static_cast<Index>(j)) * variance;
+    estimate.standard_error = attempt.dropped[j] || !(diagonal >= Ext(0)) ? kNaN : to_double(sqrt(diagonal));
     estimate.ci_low = estimate.value - t * estimate.standard_error;
     estimate.ci_high = estimate.value + t * estimate.standard_error;
     summary.parameters.push_back(std::move(estimate));
@@ -654,6 +681,34 @@ bool LeastSquaresOptions::is_valid(std::string* why) const {
   if (!(confidence_level > 0 && confidence_level < 1)) return fail("confidence_level must be in (0, 1)");
   if (!(extended_work_limit >= 0)) return fail("extended_work_limit must be >= 0");
   return true;
+}
+
+std::vector<std::string> unrepresentable_statistics(const LeastSquaresSummary& summary) {
+  std::vector<std::string> found;
+  if (summary.termination != LeastSquaresSummary::Termination::success &&
+      summary.termination != LeastSquaresSummary::Termination::rank_deficient)
+    return found;
+  const auto why = [](double value) { return std::isnan(value) ? std::string("NaN") : fmt::format("{}", value); };
+  // G under- or overflows a double while sqrt(G/n), computed from the extended G, does not.
+  if (summary.G == 0 && summary.standard_error > 0)
+    found.push_back("G(a) = sum of squared residuals (below the smallest double, shown as 0)");
+  else if (std::isinf(summary.G) && std::isfinite(summary.standard_error))
+    found.push_back("G(a) = sum of squared residuals (above the largest double, shown as inf)");
+  else if (!std::isfinite(summary.G))
+    found.push_back(fmt::format("G(a) = sum of squared residuals ({})", why(summary.G)));
+  const std::pair<const char*, double> statistics[] = {
+      {"the standard error sqrt(G/n)", summary.standard_error}, {"the residual SD", summary.residual_sd},
+      {"R^2", summary.r_squared}, {"AIC", summary.aic}, {"BIC", summary.bic}};
+  for (const auto& [name, value] : statistics)
+    if (!std::isfinite(value)) found.push_back(fmt::format("{} ({})", name, why(value)));
+  for (const ParameterEstimate& estimate : summary.parameters) {
+    if (std::isnan(estimate.value) && std::isnan(estimate.standard_error)) continue;  // dropped as dependent
+    if (estimate.value == 0 && std::isnan(estimate.standard_error) && summary.rank < summary.p) continue;
+    if (!std::isfinite(estimate.value)) found.push_back(fmt::format("`{}` ({})", estimate.name, why(estimate.value)));
+    if (!std::isfinite(estimate.standard_error))
+      found.push_back(fmt::format("the standard error of `{}` ({})", estimate.name, why(estimate.standard_error)));
+  }
+  return found;
 }
 
 const char* to_string(LeastSquaresSummary::Termination termination) {

@@ -174,6 +174,14 @@ struct LeastSquaresSummary {
                                      // basic solution (dependent parameters 0) for diagnosis only
 };
 
+// The statistics of a solved summary (success or rank_deficient) that are not finite numbers, or
+// that a double cannot hold, each as reports name it with why: "G(a) = sum of squared residuals
+// (above the largest double, shown as inf)", "the standard error of `a1` (NaN)". The statistics are
+// computed from G in extended precision, so data of any scale a double holds give finite ones; what
+// remains is G itself beyond a double, and what no scaling can give (no degrees of freedom left,
+// n == rank). Columns dropped as dependent are left out: rank deficiency is reported on its own.
+std::vector<std::string> unrepresentable_statistics(const LeastSquaresSummary& summary);
+
 const char* to_string(LeastSquaresSummary::Termination termination);
 const char* to_string(Precision precision);
 

@@ -333,6 +333,74 @@ TEST(LeastSquares, ExactlyDeterminedSystemHasNoStandardErrors) {
   EXPECT_TRUE(std::isnan(summary.parameters[0].standard_error));
 }
 
+// Issue 19: a record in other units is the same fit. Columns and known side multiplied by s leave
+// the parameters, their relative standard errors and R^2 as they were; sqrt(G/n) scales by s and
+// AIC, BIC shift by 2 n log s. Before, s = 1e200 gave infinite standard errors (G overflowed a
+// double), s = 1e-300 zero ones (G underflowed: a false exact fit) and subnormal data NaN.
+TEST(LeastSquares, StatisticsAreScaleInvariant) {
+  Eigen::MatrixXd A = random_matrix(80, 3, 21);
+  A.col(0).setOnes();  // an intercept, so R^2 is the centred one
+  std::mt19937 generator(22);
+  std::normal_distribution<double> noise(0, 0.05);
+  Eigen::VectorXd b = A * Eigen::Vector3d(0.5, -2, 3);
+  for (Eigen::Index i = 0; i < b.size(); ++i) b(i) += noise(generator);
+  for (Precision precision : {Precision::extended, Precision::double_precision}) {
+    LeastSquaresOptions options;
+    options.precision = precision;
+    const LeastSquaresSummary reference = solve_least_squares(A, b, names_of(3), nullptr, options);
+    ASSERT_EQ(reference.termination, Termination::success);
+    EXPECT_TRUE(unrepresentable_statistics(reference).empty());
+    // 1e-310 is subnormal: the data themselves keep only about 44 bits, hence the wider tolerance.
+    for (const auto& [scale, tolerance] : {std::pair{1e200, 1e-12}, std::pair{1e-300, 1e-12}, std::pair{1e-310, 1e-9}}) {
+      SCOPED_TRACE(::testing::Message() << "scale " << scale << ", " << to_string(precision));
+      const LeastSquaresSummary scaled = solve_least_squares(A * scale, b * scale, names_of(3), nullptr, options);
+      ASSERT_EQ(scaled.termination, Termination::success) << scaled.message;
+      for (std::size_t j = 0; j < 3; ++j) {
+        const ParameterEstimate& mine = scaled.parameters[j];
+        const ParameterEstimate& theirs = reference.parameters[j];
+        EXPECT_LT(relative_error(mine.value, theirs.value), tolerance);
+        ASSERT_TRUE(std::isfinite(mine.standard_error) && mine.standard_error > 0) << mine.standard_error;
+        EXPECT_LT(relative_error(mine.standard_error / mine.value, theirs.standard_error / theirs.value), tolerance);
+      }
+      EXPECT_LT(relative_error(scaled.r_squared, reference.r_squared), tolerance);
+      EXPECT_LT(relative_error(scaled.standard_error, reference.standard_error * scale), tolerance);
+      const double shift = 2 * 80 * std::log(scale);
+      EXPECT_NEAR(scaled.aic, reference.aic + shift, 1e-9 * std::abs(shift));
+      EXPECT_NEAR(scaled.bic, reference.bic + shift, 1e-9 * std::abs(shift));
+      // What a double cannot hold is named: G near 1e400 or 1e-600.
+      const std::vector<std::string> named = unrepresentable_statistics(scaled);
+      ASSERT_EQ(named.size(), 1u);
+      EXPECT_NE(named[0].find(scale > 1 ? "above the largest double, shown as inf" : "below the smallest double, shown as 0"),
+                std::string::npos) << named[0];
+    }
+  }
+}
+
+// Only the known side in other units (the parameters carry the units): every parameter scales,
+// relative standard errors and R^2 do not.
+TEST(LeastSquares, KnownSideScaleMovesOnlyTheParameters) {
+  const Eigen::MatrixXd A = random_matrix(40, 2, 23);
+  const Eigen::VectorXd b = A * Eigen::Vector2d(1, -1) + orthogonal_residual(A, 0.5, 24);
+  const LeastSquaresSummary reference = solve_least_squares(A, b, names_of(2), nullptr, {});
+  for (double scale : {1e250, 1e-250}) {
+    const LeastSquaresSummary scaled = solve_least_squares(A, b * scale, names_of(2), nullptr, {});
+    ASSERT_EQ(scaled.termination, Termination::success);
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_LT(relative_error(scaled.parameters[j].value, reference.parameters[j].value * scale), 1e-13);
+      EXPECT_LT(relative_error(scaled.parameters[j].standard_error, reference.parameters[j].standard_error * scale), 1e-12);
+    }
+    EXPECT_LT(relative_error(scaled.r_squared, reference.r_squared), 1e-13);
+  }
+}
+
+TEST(LeastSquares, NoDegreesOfFreedomIsNamedAsNotFinite) {
+  const Eigen::MatrixXd A = random_matrix(3, 3, 15);
+  const LeastSquaresSummary summary = solve_least_squares(A, A * Eigen::Vector3d(1, 2, 3), names_of(3), nullptr, {});
+  const std::vector<std::string> named = unrepresentable_statistics(summary);
+  EXPECT_NE(std::find(named.begin(), named.end(), "the residual SD (NaN)"), named.end());
+  EXPECT_NE(std::find(named.begin(), named.end(), "the standard error of `a1` (NaN)"), named.end());
+}
+
 // A Wampler1-like fit (degree 5 on x = 0..20, exact data): plain QR in double loses digits,
 // refinement against the original rows recovers them, and extended precision all of them.
 TEST(LeastSquares, RefinementRecoversDigitsOnAnIllConditionedPolynomial) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "diagnostics/model_catalogue.hpp"
+#include "ir/queries.hpp"
 
 namespace sidc {
 
@@ -126,22 +127,6 @@ class UnitOf {
 };
 
 }  // namespace
-
-bool has_units(const ir::Model& model) {
-  if (model.settings.values.count("time_unit")) return true;
-  for (const auto& s : model.signals)
-    if (s.unit) return true;
-  return false;
-}
-
-ir::Unit time_unit(const ir::Model& model) {
-  const auto it = model.settings.values.find("time_unit");
-  if (it != model.settings.values.end())
-    if (auto u = ir::parse_unit(it->second.text)) return *u;  // checked by declare_pass
-  Unit seconds;
-  seconds.powers.emplace("s", Number(1));
-  return seconds;
-}
 
 void unit_pass(ir::Model& model, Diagnostics& diagnostics) {
   if (!has_units(model)) return;

@@ -24,12 +24,6 @@
 
 namespace sidc {
 
-// True when the model gives any unit (a signal's or the time's).
-bool has_units(const ir::Model& model);
-
-// The unit of time: `set time_unit`, else seconds.
-ir::Unit time_unit(const ir::Model& model);
-
 // Sets Parameter::unit where it can be derived and is not set yet; reports what cannot match.
 void unit_pass(ir::Model& model, Diagnostics& diagnostics);
 

@@ -52,4 +52,20 @@ const ir::Signal* first_piecewise_input(const ir::Model& model, const ir::Sum& s
   return found;
 }
 
+bool has_units(const ir::Model& model) {
+  if (model.settings.values.count("time_unit")) return true;
+  for (const auto& s : model.signals)
+    if (s.unit) return true;
+  return false;
+}
+
+ir::Unit time_unit(const ir::Model& model) {
+  const auto it = model.settings.values.find("time_unit");
+  if (it != model.settings.values.end())
+    if (auto u = ir::parse_unit(it->second.text)) return *u;  // checked by declare_pass
+  ir::Unit seconds;
+  seconds.powers.emplace("s", Number(1));
+  return seconds;
+}
+
 }  // namespace sidc

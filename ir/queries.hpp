@@ -28,4 +28,10 @@ const ir::Signal* piecewise_input(const ir::Model& model, const std::string& nam
 // The first held or linear input occurring in `s`, inside integrals, functions and guards too; nullptr if none.
 const ir::Signal* first_piecewise_input(const ir::Model& model, const ir::Sum& s);
 
+// True when the model gives any unit (a signal's, or `set time_unit`): docs/language.md, "Units".
+bool has_units(const ir::Model& model);
+
+// The unit of t: `set time_unit`, else seconds.
+ir::Unit time_unit(const ir::Model& model);
+
 }  // namespace sidc

@@ -13,6 +13,7 @@
 #include "diagnostics/cli_catalogue.hpp"
 #include "report/atomic_file.hpp"
 #include "ir/print.hpp"
+#include "ir/queries.hpp"
 #include "ir/traversal.hpp"
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
@@ -135,14 +136,20 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
   std::vector<NamedFigure> figures;
   const ir::Model& model = c.compiled.integrated;
   const ir::Model& normalized = c.compiled.normalized;
-  const SignalLabel time{"t", ""};
+  // Units on the axes where the model gives them (docs/language.md, "Units").
+  const bool units = has_units(normalized);
+  const SignalLabel time{"t", units ? to_string(time_unit(normalized)) : ""};
+  auto unit_of = [&](const std::string& name) {
+    const ir::Signal* s = normalized.signal(name);
+    return s && s->unit ? to_string(*s->unit) : std::string();
+  };
   const auto suffix = [&](std::size_t r) { return c.records.size() > 1 ? fmt::format("_r{}", r + 1) : std::string(); };
 
   // Figs. 4-2.5/4-2.6 and 4-2.7: the solved fitted equations against each record.
   for (std::size_t v = 0; v < c.validations.size(); ++v) {
     const ValidationSummary& run = c.validations[v];
     for (std::size_t o = 0; o < run.outputs.size(); ++o) {
-      const SignalLabel output{run.outputs[o].output, ""};
+      const SignalLabel output{run.outputs[o].output, unit_of(run.outputs[o].output)};
       Figure a = recorded_vs_simulated_figure(time, output, run.simulation.time, run.recorded[o], run.simulated[o]);
       Figure b = simulation_error_figure(time, output, run.simulation.time, run.recorded[o], run.simulated[o]);
       const std::string s = c.validations.size() > 1 ? fmt::format("_r{}", v + 1) : std::string();
@@ -196,7 +203,7 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
       }
       for (const auto& [signal, comparisons] : by_signal) {
         const std::string setting = fmt::format("Delta = {:g}, {}", record.step, estimates.arc_of(signal, comparisons.front().order));
-        Figure f = derivative_error_figure(time, {signal, ""}, at, comparisons, setting);
+        Figure f = derivative_error_figure(time, {signal, unit_of(signal)}, at, comparisons, setting);
         f.name += suffix(r);
         f.title += ", record " + record_name(record.path);
         figures.push_back({std::move(f)});
@@ -208,7 +215,7 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
       auto y = estimates.of(s.name, 0);
       auto y_dot = estimates.of(s.name, 1);
       if (!y || !y_dot) continue;
-      Figure f = phase_plane_figure({s.name, ""}, "s", y->values, y_dot->values);
+      Figure f = phase_plane_figure({s.name, unit_of(s.name)}, time.unit, y->values, y_dot->values);
       f.name += suffix(r);
       f.title += ", record " + record_name(record.path);
       figures.push_back({std::move(f)});

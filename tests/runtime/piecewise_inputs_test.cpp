@@ -52,8 +52,8 @@ TEST(IntervalRule, IsTheCubicParabolaAndTrapezoidRule) {
 
 ir::Model model_with(ir::Signal::Hold hold) {
   ir::Model m;
-  ir::Signal x{"x", ir::Signal::Kind::input, {}, {}, true, hold, {}};
-  ir::Signal y{"y", ir::Signal::Kind::output, {}, {}, true, ir::Signal::Hold::smooth, {}};
+  ir::Signal x{"x", ir::Signal::Kind::input, {}, {}, true, hold, {}, std::nullopt};
+  ir::Signal y{"y", ir::Signal::Kind::output, {}, {}, true, ir::Signal::Hold::smooth, {}, std::nullopt};
   m.signals = {x, y};
   return m;
 }

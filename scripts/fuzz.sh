@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target (tests/fuzz/) for a long time: an hour each by default, one after the
 # other, in the sanitizer tree that scripts/test.sh --sanitize builds (build-asan/, Clang, ASan and
-# UBSan). The corpus each target grows is kept in build-asan/tests/fuzz/<target>/corpus, so a
+# UBSan). The corpus each target grows is kept in build-asan/tests/fuzz/<target>.work/corpus, so a
 # later run starts where this one ended.
 #
 # Usage: bash scripts/fuzz.sh [SECONDS_EACH [TARGET...]]
@@ -31,6 +31,6 @@ for target in "${targets[@]}"; do
   esac
   echo "fuzz.sh: $target for $seconds s"
   bash "$repo_root/tests/fuzz/run_fuzz.sh" "$build/tests/fuzz/$target" "$kind" "$seconds" \
-    "$build/tests/fuzz/$target" "$build/cli/sidc"
+    "$build/tests/fuzz/$target.work" "$build/cli/sidc"
 done
 echo "fuzz.sh: ${#targets[@]} target(s), $seconds s each: nothing found"

@@ -161,9 +161,16 @@ struct Reader {
   }
   Number number(const json& j) const {
     if (j.contains("real")) return Number::real(j.at("real").get<double>());
-    const auto den = j.at("den").get<std::int64_t>();
+    // A damaged file may hold 1e83 where an integer belongs: converting it would be undefined
+    // behaviour (the fuzzer found it), so only JSON integers are read as integers.
+    auto integer = [&](const char* key) {
+      const json& v = j.at(key);
+      if (!v.is_number_integer()) throw std::runtime_error(std::string("a number's `") + key + "` is not an integer");
+      return v.get<std::int64_t>();
+    };
+    const auto den = integer("den");
     if (den <= 0) throw std::runtime_error("a denominator is not positive");
-    return Number::rational(j.at("num").get<std::int64_t>(), den);
+    return Number::rational(integer("num"), den);
   }
   ir::SumPtr sum_ptr(const json& j) const { return ir::share(sum(j)); }
   ir::Sum sum(const json& j) const {

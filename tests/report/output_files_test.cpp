@@ -34,10 +34,7 @@ namespace fs = std::filesystem;
 using sidc::testing::read_text;
 using sidc::testing::shell_quoted;
 
-struct SidcRun {
-  int status = -1;
-  std::string out, err;
-};
+using SidcRun = sidc::testing::CommandRun;
 
 // A fresh folder of the running test's own (ctest runs the tests as parallel processes), holding
 // a first-order model and a record it fits exactly (y = exp(-2t): a = 2).
@@ -54,15 +51,8 @@ fs::path work() {
 
 // Runs `sidc ARGUMENTS` in `dir` (a 20 s limit: a hang fails rather than blocks the suite).
 SidcRun run_sidc(const fs::path& dir, const std::string& arguments, const std::string& stdout_to = "") {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = "cd " + shell_quoted(dir) + " && timeout 20 " + shell_quoted(SIDC_BINARY) + " " + arguments + " >" +
-                              (stdout_to.empty() ? shell_quoted(out) : stdout_to) + " 2>" + shell_quoted(err);
-  const int raw = std::system(command.c_str());
-  SidcRun run;
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  run.out = read_text(out);
-  run.err = read_text(err);
-  return run;
+  return sidc::testing::run_captured("cd " + shell_quoted(dir) + " && timeout 20 " + shell_quoted(SIDC_BINARY) + " " + arguments,
+                                     dir / "stdout.txt", dir / "stderr.txt", stdout_to);
 }
 
 std::size_t temporaries_in(const fs::path& dir) {

@@ -32,10 +32,7 @@ using sidc::testing::shell_quoted;
 const fs::path kWork = SIDC_SELECT_WORK_DIR;
 const fs::path kModels = SIDC_SELECT_DIR;
 
-struct SidcRun {
-  int status = -1;
-  std::string out, err;
-};
+using SidcRun = sidc::testing::CommandRun;
 
 // A folder of the running test's own: ctest runs the tests as parallel processes.
 fs::path work() {
@@ -45,14 +42,7 @@ fs::path work() {
 }
 
 SidcRun run_sidc(const std::string& arguments) {
-  const fs::path out = work() / "stdout.txt", err = work() / "stderr.txt";
-  const std::string command = shell_quoted(SIDC_BINARY) + " " + arguments + " >" + shell_quoted(out) + " 2>" + shell_quoted(err);
-  const int raw = std::system(command.c_str());
-  SidcRun run;
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  run.out = read_text(out);
-  run.err = read_text(err);
-  return run;
+  return sidc::testing::run_captured(shell_quoted(SIDC_BINARY) + " " + arguments, work() / "stdout.txt", work() / "stderr.txt");
 }
 
 // The clean record, made once by `sidc simulate` (RK4, 10 substeps per 0.01 s sample).

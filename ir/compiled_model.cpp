@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <set>
 #include <unordered_map>
+#include <utility>
 
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
@@ -39,6 +40,17 @@ std::optional<FactorKind> kind_from(const std::string& s) {
   for (int k = 0; k <= static_cast<int>(FactorKind::guard); ++k)
     if (s == kind_name(static_cast<FactorKind>(k))) return static_cast<FactorKind>(k);
   return std::nullopt;
+}
+
+// A damaged file may hold 1e83 or 2^40 where a small integer belongs: converting it would be
+// undefined behaviour (the fuzzer found one), so every integer is checked before it is read.
+template <class T>
+T integer(const json& j, const char* key) {
+  const json& v = j.at(key);
+  if (v.is_number_unsigned() && std::in_range<T>(v.get<std::uint64_t>())) return static_cast<T>(v.get<std::uint64_t>());
+  if (v.is_number_integer() && !v.is_number_unsigned() && std::in_range<T>(v.get<std::int64_t>()))
+    return static_cast<T>(v.get<std::int64_t>());
+  throw std::runtime_error(fmt::format("`{}` is {}, not an integer that fits", key, v.dump()));
 }
 
 ordered number_json(const Number& n) {
@@ -156,21 +168,15 @@ struct Reader {
 
   Span span(const json& j) const {
     if (j.is_null()) return {};
-    const std::size_t begin = j.at("offset").get<std::size_t>();
-    return Span{source, begin, begin + j.at("length").get<std::size_t>()};
+    const auto begin = integer<std::size_t>(j, "offset"), length = integer<std::size_t>(j, "length");
+    if (begin > source->text.size() || length > source->text.size() - begin) throw std::runtime_error("a span outside the source text");
+    return Span{source, begin, begin + length};
   }
   Number number(const json& j) const {
     if (j.contains("real")) return Number::real(j.at("real").get<double>());
-    // A damaged file may hold 1e83 where an integer belongs: converting it would be undefined
-    // behaviour (the fuzzer found it), so only JSON integers are read as integers.
-    auto integer = [&](const char* key) {
-      const json& v = j.at(key);
-      if (!v.is_number_integer()) throw std::runtime_error(std::string("a number's `") + key + "` is not an integer");
-      return v.get<std::int64_t>();
-    };
-    const auto den = integer("den");
+    const auto den = integer<std::int64_t>(j, "den");
     if (den <= 0) throw std::runtime_error("a denominator is not positive");
-    return Number::rational(integer("num"), den);
+    return Number::rational(integer<std::int64_t>(j, "num"), den);
   }
   ir::SumPtr sum_ptr(const json& j) const { return ir::share(sum(j)); }
   ir::Sum sum(const json& j) const {
@@ -190,7 +196,7 @@ struct Reader {
     for (const auto& t : j.at("terms")) {
       ir::Term term{number(t.at("coefficient")), {}, span(t.at("span"))};
       for (const auto& f : t.at("factors")) {
-        const int power = f.at("power").get<int>();
+        const int power = integer<int>(f, "power");
         if (power == 0) throw std::runtime_error("a factor with power 0");
         term.factors.push_back({factor(f), power});
       }
@@ -204,7 +210,7 @@ struct Reader {
     if (*kind == FactorKind::parameter) throw std::runtime_error("a parameter factor inside an operation");
     if ((*kind == FactorKind::signal || *kind == FactorKind::initial_value) && !signals.count(j.at("name").get<std::string>()))
       throw std::runtime_error("a factor names the undeclared signal `" + j.at("name").get<std::string>() + "`");
-    ir::Factor f{*kind, j.value("name", std::string()), j.value("order", 0), {}, {}, {}, {}};
+    ir::Factor f{*kind, j.value("name", std::string()), j.contains("order") ? integer<int>(j, "order") : 0, {}, {}, {}, {}};
     if (f.order < 0 || f.order > kMaxOrder) throw std::runtime_error(fmt::format("a derivative order of {}", f.order));
     if (*kind == FactorKind::initial_value && !j.at("at").is_null()) f.at = number(j.at("at"));
     if (j.contains("exponent")) f.exponent = number(j.at("exponent"));
@@ -275,7 +281,7 @@ std::vector<ir::Equation> read_equations(const json& j, const ParameterIndices& 
   for (const auto& e : j) {
     ir::Equation eq;
     eq.span = r.span(e.at("span"));
-    eq.integrations = e.at("integrations").get<int>();
+    eq.integrations = integer<int>(e, "integrations");
     eq.weak = e.value("weak", false);
     eq.integration.constants = one_of(e, "constants", {"fitted", "initial"}) == "initial" ? ir::IntegrationRequest::Constants::initial
                                                                                            : ir::IntegrationRequest::Constants::fitted;
@@ -391,8 +397,8 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       error = render(cli_diag::not_a_compiled_model(path));
       return std::nullopt;
     }
-    if (j.at("version").get<int>() != kCompiledModelVersion) {
-      error = render(cli_diag::compiled_model_version(path, j.at("version").get<int>(), kCompiledModelVersion));
+    if (integer<int>(j, "version") != kCompiledModelVersion) {
+      error = render(cli_diag::compiled_model_version(path, integer<int>(j, "version"), kCompiledModelVersion));
       return std::nullopt;
     }
     CompiledModel c;
@@ -427,7 +433,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
                               origin == "implicit" ? ir::Parameter::Origin::implicit
                               : origin == "integration_constant" ? ir::Parameter::Origin::integration_constant
                                                                   : ir::Parameter::Origin::declared,
-                              r.span(p.at("span")), p.at("equation").get<int>(), std::nullopt});
+                              r.span(p.at("span")), integer<int>(p, "equation"), std::nullopt});
     }
     for (const auto& [name, value] : j.at("constants").items()) m.constants.emplace(name, r.number(value));
     for (const auto& [key, value] : j.at("settings").at("as_written").items()) {
@@ -444,7 +450,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       for (const auto& x : d.at("exact_derivatives")) {
         const std::string signal = x.at("signal").get<std::string>();
         if (!r.signals.count(signal)) throw std::runtime_error("an exact derivative names the undeclared signal `" + signal + "`");
-        const int order = x.at("order").get<int>();
+        const int order = integer<int>(x, "order");
         if (order < 1 || order > kMaxOrder) throw std::runtime_error(fmt::format("an exact derivative of order {}", order));
         source.exact_derivatives.push_back({signal, order, x.at("column").get<std::string>(), {}});
       }
@@ -463,7 +469,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
       plot.span = r.span(p.at("span"));
       plot.signal = p.at("signal").get<std::string>();
       if (!r.signals.count(plot.signal)) throw std::runtime_error("a plot names the undeclared signal `" + plot.signal + "`");
-      plot.order = p.at("order").get<int>();
+      plot.order = integer<int>(p, "order");
       if (plot.order < 0 || plot.order > kMaxOrder) throw std::runtime_error(fmt::format("a plot against a derivative of order {}", plot.order));
       plot.terms = read_operations(p.at("operations"), normalized_indices, r);
       plot.rest = r.sum(p.at("rest"));

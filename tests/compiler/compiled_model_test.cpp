@@ -443,6 +443,19 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
          }
          j["equations"][0]["operations"][0]["operation"] = json::parse(open + text + close);
        }, {"nested more than 256 levels deep"}},
+      // Found by the compiled-model fuzz target in CI's sanitizer pass: a float where an integer
+      // belongs was converted to int64, which is undefined behaviour.
+      {"a numerator of 1e83", [&](json& j) { j[first_coefficient] = {{"num", 1e83}, {"den", 1}}; }, {"`num` is ", ", not an integer that fits"}},
+      {"a denominator of 2.5", [&](json& j) { j[first_coefficient] = {{"num", 1}, {"den", 2.5}}; }, {"`den` is ", ", not an integer that fits"}},
+      {"a power of 1e83", [&](json& j) { j[first_factor]["power"] = 1e83; }, {"`power` is ", ", not an integer that fits"}},
+      {"a power of 2^40", [&](json& j) { j[first_factor]["power"] = std::int64_t{1} << 40; }, {"`power` is ", ", not an integer that fits"}},
+      {"an order of -1e300", [&](json& j) {
+         j[first_factor]["kind"] = "signal", j[first_factor]["name"] = "y", j[first_factor]["order"] = -1e300;
+       }, {"`order` is ", ", not an integer that fits"}},
+      {"a version of 1e83", [](json& j) { j["version"] = 1e83; }, {"`version` is ", ", not an integer that fits"}},
+      {"a span past the end of the source text", [](json& j) { j["equations"][0]["span"] = {{"offset", 5}, {"length", 1u << 30}}; },
+       {"a span outside the source text"}},
+      {"a negative span offset", [](json& j) { j["equations"][0]["span"] = {{"offset", -3}, {"length", 1}}; }, {"`offset` is ", ", not an integer that fits"}},
       {"a derivative order past the compiler's 64", [&](json& j) {
          j[first_factor]["kind"] = "signal", j[first_factor]["name"] = "y", j[first_factor]["order"] = 65;
        }, {"derivative order of 65"}},

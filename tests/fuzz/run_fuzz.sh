@@ -41,6 +41,8 @@ case "$kind" in
         out=$seeds/$(echo "${m#"$repo_root"/}" | tr '/' '_').sidc.json
         "$sidc" compile "$m" -o "$out" >/dev/null 2>&1 || rm -f "$out"
       done
+      # Damaged compiled models of the catalogue, the fuzzers' findings among them, replay each run.
+      for f in "$repo_root"/tests/golden/*/*.files/*.sidc.json; do [[ -e $f ]] && add_seed "$f"; done
       touch "$seeds/.complete"
     fi
     if [[ $kind == compiled ]]; then max_len=65536; fi ;;

@@ -1,10 +1,14 @@
 #include "report/fit_pictures.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <fstream>
+#include <iterator>
 #include <fmt/format.h>
 #include <limits>
 #include <map>
@@ -289,23 +293,43 @@ ReportContent report_content(const PictureContext& c) {
 // The folder holds this run's pictures only: those an earlier run listed in its manifest
 // (kPictureManifest) and this run did not draw again are removed. Only names sidc wrote there, as
 // the manifest lists them, plain file names ending in .svg or .png; a user's own files are never
-// touched. Then the manifest lists this run's. A manifest that cannot be written costs nothing
-// but the next run's cleaning.
+// touched.
 constexpr const char* kPictureManifest = ".sidc-pictures";
 
-void forget_stale_pictures(const fs::path& directory, const std::vector<std::string>& drawn) {
-  std::set<std::string> now;
-  for (const auto& f : drawn) now.insert(fs::path(f).filename().string());
+std::vector<std::string> stale_pictures(const fs::path& directory, const std::set<std::string>& now) {
+  std::vector<std::string> stale;
   std::ifstream before(directory / kPictureManifest);
-  std::error_code ec;
   for (std::string name; std::getline(before, name);) {
     const bool picture = name.ends_with(".svg") || name.ends_with(".png");
-    if (picture && name.find('/') == std::string::npos && name[0] != '.' && !now.count(name)) fs::remove(directory / name, ec);
+    if (picture && name.find('/') == std::string::npos && name[0] != '.' && !now.count(name)) stale.push_back((directory / name).string());
   }
-  std::string list;
-  for (const auto& name : now) list += name + "\n";
-  std::string why;
-  write_file_atomically((directory / kPictureManifest).string(), list, &why);
+  return stale;
+}
+
+// A private folder for drawing, removed with this object: gnuplot writes there, and only a whole
+// set of figures leaves it, so a failure halfway leaves the user's folder as it was.
+class ScratchFolder {
+ public:
+  ScratchFolder() {
+    std::error_code ec;
+    std::string pattern = (fs::temp_directory_path(ec) / "sidc-figures.XXXXXX").string();
+    if (!ec && ::mkdtemp(pattern.data())) path_ = pattern;
+  }
+  ~ScratchFolder() {
+    std::error_code ec;
+    if (!path_.empty()) fs::remove_all(path_, ec);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string file_contents(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -313,59 +337,71 @@ void forget_stale_pictures(const fs::path& directory, const std::vector<std::str
 bool write_fit_pictures(const PictureContext& context, const PictureRequest& request, std::vector<std::string>& written,
                         std::string& error) {
   if (request.plots_directory.empty() && request.report_path.empty()) return true;
-  // Without --plots the report's figures are drawn in a scratch folder beside it and removed.
-  const bool scratch = request.plots_directory.empty();
-  fs::path directory = request.plots_directory;
+  const fs::path directory = request.plots_directory;  // empty: the report's figures only
   std::error_code ec;
-  if (scratch) {
-    const fs::path report(request.report_path);
-    directory = (report.has_parent_path() ? report.parent_path() : fs::path(".")) / (report.filename().string() + ".figures.tmp");
+  if (!directory.empty()) {
+    fs::create_directories(directory, ec);
+    if (ec) {
+      error = render(cli_diag::cannot_create_directory(directory.string(), ec.message(), "choose a folder you can write to"));
+      return false;
+    }
   }
-  fs::create_directories(directory, ec);
-  if (ec) {
-    error = render(cli_diag::cannot_create_directory(directory.string(), ec.message(), "choose a folder you can write to"));
+  const ScratchFolder scratch;
+  if (scratch.path().empty()) {
+    error = render(cli_diag::cannot_create_directory(fs::temp_directory_path(ec).string(), std::strerror(errno),
+                                                     "set TMPDIR to a folder you can write to"));
     return false;
   }
   ReportContent content = report_content(context);
-  std::vector<std::string> drawn;
-  bool ok = true;
+  std::vector<std::string> drawn;  // file names, in the scratch folder
   for (const auto& [figure, group] : fit_figures(context)) {
-    const RenderSummary r = render_figure(figure, directory.string(), {});
+    const RenderSummary r = render_figure(figure, scratch.path().string(), {});
     if (!r.ok()) {
       error = render(cli_diag::cannot_draw_figure(figure.name, r.message));
-      ok = false;
-      break;
+      return false;
     }
-    drawn.insert(drawn.end(), r.files.begin(), r.files.end());
+    for (const auto& f : r.files) drawn.push_back(fs::path(f).filename().string());
     if (request.report_path.empty()) continue;
     std::string why;
     ReportFigure f = report_figure_from_file(r.files.front(), figure.title, &why);
     if (f.svg.empty()) {
       error = render(cli_diag::cannot_read_back_figure(figure.name, why));
-      ok = false;
-      break;
+      return false;
     }
     if (group >= 0 && static_cast<std::size_t>(group) < content.groups.size()) content.groups[static_cast<std::size_t>(group)].figures.push_back(std::move(f));
     else content.figures.push_back(std::move(f));
   }
-  if (ok && !request.report_path.empty()) {
-    const ReportWriteSummary w = write_html_report(content, request.report_path);
-    if (!w.ok) {
-      error = render(cli_diag::cannot_write(w.message));
-      ok = false;
-    } else {
-      written.push_back(request.report_path);
+  // The pictures, their manifest and the report appear together or not at all.
+  AtomicFileSet set;
+  std::string why;
+  std::vector<std::string> stale;
+  if (!directory.empty()) {
+    std::set<std::string> now(drawn.begin(), drawn.end());
+    std::string manifest;
+    for (const auto& name : now) manifest += name + "\n";
+    for (const auto& name : drawn) {
+      if (!set.add((directory / name).string(), file_contents(scratch.path() / name), &why)) {
+        error = render(cli_diag::cannot_write(why));
+        return false;
+      }
     }
+    if (!set.add((directory / kPictureManifest).string(), manifest, &why)) {
+      error = render(cli_diag::cannot_write(why));
+      return false;
+    }
+    stale = stale_pictures(directory, now);
   }
-  if (scratch) {
-    fs::remove_all(directory, ec);
-  } else if (!ok) {
-    for (const auto& f : drawn) fs::remove(f, ec);  // no half set of pictures
-  } else {
-    written.insert(written.end(), drawn.begin(), drawn.end());
-    forget_stale_pictures(directory, drawn);
+  if (!request.report_path.empty() && !set.add(request.report_path, render_html_report(content), &why)) {
+    error = render(cli_diag::cannot_write(why));
+    return false;
   }
-  return ok;
+  if (!set.commit(&why, stale)) {
+    error = render(cli_diag::cannot_write(why));
+    return false;
+  }
+  for (const auto& name : drawn) written.push_back((directory / name).string());
+  if (!request.report_path.empty()) written.push_back(request.report_path);
+  return true;
 }
 
 }  // namespace sidc

@@ -80,4 +80,30 @@ TEST(ThesisPictures, AFailingFigureLeavesNoReportBehind) {
   EXPECT_FALSE(fs::exists(work / "report.html"));
 }
 
+// A run that cannot draw leaves the previous run's pictures, manifest and report as they were:
+// pictures are drawn in a private folder under $TMPDIR and only a whole set replaces the old one
+// (here $TMPDIR does not exist, so the second run fails before it draws anything).
+TEST(ThesisPictures, AFailedRunLeavesThePreviousPicturesAsTheyWere) {
+  const fs::path work = example_copy("pictures_kept");
+  const std::string fit = shell_quoted(SIDC_BINARY) + " fit quasi_linear.sid --plots pictures --report report.html";
+  const fs::path log = work / "fit.log";
+  ASSERT_EQ(std::system(("cd " + shell_quoted(work) + " && " + fit + " >" + shell_quoted(log) + " 2>&1").c_str()), 0) << read_text(log);
+  std::vector<std::pair<fs::path, std::string>> before;
+  for (const auto& entry : fs::directory_iterator(work / "pictures")) before.emplace_back(entry.path(), read_text(entry.path()));
+  before.emplace_back(work / "report.html", read_text(work / "report.html"));
+  ASSERT_GT(before.size(), 10u);
+
+  const std::string again = "cd " + shell_quoted(work) + " && TMPDIR=" + shell_quoted(work / "no-such-folder") + " " + fit + " >" +
+                            shell_quoted(log) + " 2>&1";
+  EXPECT_NE(std::system(again.c_str()), 0);
+  EXPECT_NE(read_text(log).find("error: "), std::string::npos) << read_text(log);
+  std::size_t now = 0;
+  for (const auto& entry : fs::directory_iterator(work / "pictures")) {
+    (void)entry;
+    ++now;
+  }
+  EXPECT_EQ(now + 1, before.size());
+  for (const auto& [path, content] : before) EXPECT_EQ(read_text(path), content) << path;
+}
+
 }  // namespace

@@ -59,6 +59,21 @@ TEST(NoiseLevel, RecoversTheNoiseOfEveryShapeAndLevel) {
   }
 }
 
+// Scale-invariant: the same record in units of 1e200 or 1e-200 (issue 19: its spread was inf).
+TEST(NoiseLevel, TheUnitOfTheRecordDoesNotMatter) {
+  const auto noisy = with_noise(sampled(4001, 0.01, shapes().front().f), 0.01, 11);
+  const NoiseLevel one = estimate_noise_level(noisy);
+  for (double unit : {1e200, 1e-200}) {
+    std::vector<double> scaled = noisy;
+    for (double& v : scaled) v *= unit;
+    const NoiseLevel n = estimate_noise_level(scaled);
+    EXPECT_NEAR(n.spread / unit, one.spread, 1e-12 * one.spread) << unit;
+    EXPECT_NEAR(n.sigma / unit, one.sigma, 1e-12 * one.sigma) << unit;
+    EXPECT_NEAR(n.relative(), one.relative(), 1e-12) << unit;
+    EXPECT_EQ(n.difference_order, one.difference_order) << unit;
+  }
+}
+
 TEST(NoiseLevel, NoNoiseGivesAVerySmallLevel) {
   for (const auto& shape : shapes()) {
     if (std::string(shape.name).find("fast") != std::string::npos) continue;  // 12 samples a period: an upper bound only

@@ -143,7 +143,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (const auto& warning : drift_warnings(model, g.drift)) std::cerr << render(warning) << "\n";
   for (const auto& warning : statistics_warnings(model, summary)) std::cerr << render(warning) << "\n";
   std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << form_report << (form_report.empty() ? "" : "\n")
-            << operator_report(summary.operators, options->evaluation);
+            << operator_report(summary.operators, options->evaluation, model);
   if (!is_static(model)) std::cout << "\n";
   std::cout << summary.full_report(model);
   // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;

@@ -68,4 +68,10 @@ ir::Unit time_unit(const ir::Model& model) {
   return seconds;
 }
 
+std::string parameter_unit(const ir::Model& model, const std::string& name) {
+  const int k = model.parameter_index(name);
+  if (k < 0 || !model.parameters[static_cast<std::size_t>(k)].unit) return {};
+  return to_string(*model.parameters[static_cast<std::size_t>(k)].unit);
+}
+
 }  // namespace sidc

@@ -34,4 +34,8 @@ bool has_units(const ir::Model& model);
 // The unit of t: `set time_unit`, else seconds.
 ir::Unit time_unit(const ir::Model& model);
 
+// The unit of the parameter `name` as printed beside its estimate (`kg`, `N*s/m`), or "" when the
+// model gives it none (or has no such parameter).
+std::string parameter_unit(const ir::Model& model, const std::string& name);
+
 }  // namespace sidc

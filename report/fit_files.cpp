@@ -6,6 +6,7 @@
 
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/print.hpp"
+#include "ir/queries.hpp"
 #include "report/atomic_file.hpp"
 
 namespace sidc {
@@ -75,8 +76,7 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
     for (const auto& p : ls.parameters) {
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}}});
       // Only for models that give units (docs/language.md, "Units"): other files stay as they were.
-      if (const int k = m.parameter_index(p.name); k >= 0 && m.parameters[static_cast<std::size_t>(k)].unit)
-        parameters.back()["unit"] = to_string(*m.parameters[static_cast<std::size_t>(k)].unit);
+      if (const std::string unit = parameter_unit(m, p.name); !unit.empty()) parameters.back()["unit"] = unit;
     }
     // The parameters' covariance sigma^2 (R^T R)^-1 (MATLAB's getcov) and its correlation, in
     // the order of `parameters`; a parameter that is not estimable has NaN in its row and column.
@@ -160,9 +160,11 @@ nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSu
   ordered_json groups = ordered_json::array();
   for (const auto& g : iv.groups) {
     ordered_json parameters = ordered_json::array();
-    for (const auto& p : g.parameters)
+    for (const auto& p : g.parameters) {
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}},
                             {"equation_error_estimate", p.equation_error}});
+      if (!p.unit.empty()) parameters.back()["unit"] = p.unit;
+    }
     groups.push_back({{"form", g.form}, {"n", g.n}, {"p", g.p}, {"residual_sd", g.residual_sd}, {"parameters", std::move(parameters)}});
   }
   return {{"termination", to_string(iv.termination)}, {"statement", iv.statement}, {"iterations", iv.iterations},
@@ -238,8 +240,10 @@ nlohmann::ordered_json finite_or_null(double v) { return std::isfinite(v) ? nloh
 
 nlohmann::ordered_json refinement_json(const RefineSummary& r) {
   nlohmann::ordered_json parameters = nlohmann::ordered_json::array(), records = nlohmann::ordered_json::array();
-  for (const auto& q : r.parameters)
+  for (const auto& q : r.parameters) {
     parameters.push_back({{"name", q.name}, {"equation_error", q.linear}, {"refined", q.refined}, {"standard_error", finite_or_null(q.standard_error)}});
+    if (!q.unit.empty()) parameters.back()["unit"] = q.unit;
+  }
   for (const auto& rec : r.records) {
     nlohmann::ordered_json state = nlohmann::ordered_json::object(), before = nlohmann::ordered_json::object(),
                            after = nlohmann::ordered_json::object();

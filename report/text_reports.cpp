@@ -3,6 +3,8 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "ir/queries.hpp"
+
 namespace sidc {
 
 namespace {
@@ -12,9 +14,17 @@ std::string derivative_label(const std::string& signal, int order) {
   return order <= 3 ? signal + std::string(static_cast<std::size_t>(order), '\'') : fmt::format("{}^({})", signal, order);
 }
 
+// " rad", " rad/s^2" for a signal's derivative of `order`, or "" when the model gives no unit.
+std::string unit_suffix(const ir::Model& model, const std::string& signal, int order) {
+  const ir::Signal* s = model.signal(signal);
+  if (!s || !s->unit) return {};
+  const ir::Unit unit = ir::simplest(ir::divide(*s->unit, ir::power(time_unit(model), Number::rational(order, 1))));
+  return " " + ir::to_string(unit);
+}
+
 }  // namespace
 
-std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options) {
+std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options, const ir::Model& model) {
   std::string out;
   for (const auto& r : reports) {
     if (r.noise.empty() && r.arcs.empty()) continue;  // a static model: rows, not a time series
@@ -23,8 +33,9 @@ std::string operator_report(const std::vector<OperatorReport>& reports, const Ev
       const NoiseLevel& n = s.level;
       if (n.constant) out += fmt::format("  {:<10} noise 0 (constant signal)\n", s.signal);
       else
-        out += fmt::format("  {:<10} noise sigma {:.3g} = {:.3g}% of its spread {:.4g} (differences of order {}){}\n", s.signal, n.sigma,
-                           100 * n.relative(), n.spread, n.difference_order, n.exceeds_variation() ? "  WARNING: noise exceeds variation" : "");
+        out += fmt::format("  {:<10} noise sigma {:.3g}{} = {:.3g}% of its spread {:.4g}{} (differences of order {}){}\n", s.signal, n.sigma,
+                           unit_suffix(model, s.signal, 0), 100 * n.relative(), n.spread, unit_suffix(model, s.signal, 0), n.difference_order,
+                           n.exceeds_variation() ? "  WARNING: noise exceeds variation" : "");
     }
     if (!r.automatic) {
       const auto& d = options.derivative;
@@ -33,8 +44,9 @@ std::string operator_report(const std::vector<OperatorReport>& reports, const Ev
       continue;
     }
     for (const auto& a : r.arcs) {
-      out += fmt::format("  {:<10} {}, estimated rms error {:.3g} (bias {:.3g}, noise {:.3g}){}\n", derivative_label(a.signal, a.order) + ":",
-                         a.describe(), a.rms_error(), a.bias, a.noise, a.noise_free ? "; noise 0: the smallest arc" : "");
+      out += fmt::format("  {:<10} {}, estimated rms error {:.3g}{} (bias {:.3g}, noise {:.3g}){}\n", derivative_label(a.signal, a.order) + ":",
+                         a.describe(), a.rms_error(), unit_suffix(model, a.signal, a.order), a.bias, a.noise,
+                         a.noise_free ? "; noise 0: the smallest arc" : "");
     }
   }
   return out;

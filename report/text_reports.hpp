@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "ir/ir.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/model_comparison.hpp"
 #include "runtime/solve/residual_analysis.hpp"
@@ -12,7 +13,8 @@ namespace sidc {
 
 // Per record: each signal's noise level (noise_level.hpp) and the derivative operators, chosen
 // by savgol(auto) with their estimated rms errors, or the one the settings name.
-std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options);
+// Noise levels and derivative errors carry the signals' units when the model gives them.
+std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options, const ir::Model& model);
 // `fitted_records`: how many of the runs are of fitted records; the rest are held out
 // (`--validate`), and each is marked so.
 std::string validation_report(const FitValidation& validation, std::size_t fitted_records);

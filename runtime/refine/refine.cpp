@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <memory>
 
+#include "ir/queries.hpp"
 #include "runtime/operators/noise_level.hpp"
 #include "runtime/records/sampling.hpp"
 #include "runtime/simulate/initial_state.hpp"
@@ -174,7 +175,8 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
   RefineSummary summary;
   summary.values = linear;
   for (std::size_t q = 0; q < normalized.parameters.size(); ++q)
-    summary.parameters.push_back({normalized.parameters[q].name, linear[q], linear[q], std::numeric_limits<double>::quiet_NaN()});
+    summary.parameters.push_back({normalized.parameters[q].name, linear[q], linear[q], std::numeric_limits<double>::quiet_NaN(),
+                                  parameter_unit(normalized, normalized.parameters[q].name)});
 
   ValidationOptions v;
   v.substeps = options.substeps > 0 ? options.substeps : 4;  // for the start's estimate; the refinement's own is chosen below
@@ -339,12 +341,15 @@ std::string RefineSummary::report() const {
                        substeps.front());
   std::size_t width = 9;
   for (const auto& q : parameters) width = std::max(width, q.name.size());
-  out += fmt::format("  {:<{}}  {:>14}  {:>14}  {:>12}  {:>29}\n", "parameter", width, "equation error", "refined", "std. error", "95% interval");
+  const bool units = std::any_of(parameters.begin(), parameters.end(), [](const RefinedParameter& q) { return !q.unit.empty(); });
+  out += fmt::format("  {:<{}}  {:>14}  {:>14}  {:>12}  {:>29}{}\n", "parameter", width, "equation error", "refined", "std. error", "95% interval",
+                     units ? "  unit" : "");
   for (const auto& q : parameters) {
     const bool known = std::isfinite(q.standard_error);
-    out += fmt::format("  {:<{}}  {:>14.7g}  {:>14.7g}  {:>12}  {:>29}\n", q.name, width, q.linear, q.refined,
+    out += fmt::format("  {:<{}}  {:>14.7g}  {:>14.7g}  {:>12}  {:>29}{}\n", q.name, width, q.linear, q.refined,
                        known ? fmt::format("{:.3g}", q.standard_error) : "-",
-                       known ? fmt::format("[{:.7g}, {:.7g}]", q.refined - 1.96 * q.standard_error, q.refined + 1.96 * q.standard_error) : "-");
+                       known ? fmt::format("[{:.7g}, {:.7g}]", q.refined - 1.96 * q.standard_error, q.refined + 1.96 * q.standard_error) : "-",
+                       q.unit.empty() ? "" : "  " + q.unit);
   }
   for (const auto& r : records) {
     out += fmt::format("  {}: from sample {}, {} samples;", r.path, r.first_sample, r.samples);

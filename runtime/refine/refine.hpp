@@ -53,6 +53,7 @@ struct RefinedParameter {
   double linear = 0;          // the equation-error estimate the refinement started from
   double refined = 0;         // the output-error estimate (the linear one when the refinement failed)
   double standard_error = 0;  // Gauss-Newton; NaN when J^T J is singular
+  std::string unit;           // as the fit table prints it; "" when the model gives none
 };
 
 struct RefinedRecord {

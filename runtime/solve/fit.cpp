@@ -588,16 +588,11 @@ std::string FitSummary::full_report(const ir::Model& model) const {
       for (const auto& r : g.regions) out += fmt::format("    {:>6}  {}\n", r.rows, r.guards);
     }
     // A unit column only for models that give units (docs/language.md, "Units").
-    auto unit_of = [&](const std::string& name) -> std::string {
-      const int k = model.parameter_index(name);
-      return k >= 0 && model.parameters[static_cast<std::size_t>(k)].unit
-                 ? to_string(*model.parameters[static_cast<std::size_t>(k)].unit) : std::string();
-    };
     const bool units = std::any_of(model.parameters.begin(), model.parameters.end(), [](const ir::Parameter& p) { return p.unit.has_value(); });
     out += fmt::format("  {:<14} {:>15} {:>13}   {:>31}{}\n", "parameter", "estimate", "std. error",
                        fmt::format("{:g}% confidence interval", 100 * 0.95), units ? "   unit" : "");
     for (const auto& p : s.parameters) {
-      const std::string unit = units ? unit_of(p.name) : std::string();
+      const std::string unit = units ? parameter_unit(model, p.name) : std::string();
       out += fmt::format("  {:<14} {:>15.6g} {:>13.4g}   [{:>13.6g}, {:>13.6g}]{}\n", p.name, p.value, p.standard_error, p.ci_low,
                          p.ci_high, unit.empty() ? "" : "   " + unit);
     }

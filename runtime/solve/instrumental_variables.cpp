@@ -14,6 +14,7 @@
 #include <boost/math/distributions/students_t.hpp>
 #include <fmt/format.h>
 
+#include "ir/queries.hpp"
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/design.hpp"
@@ -313,12 +314,15 @@ std::string InstrumentalVariablesSummary::full_report() const {
     for (double c : changes) listed += fmt::format("{}{:.2g}", listed.empty() ? "" : ", ", c);
     out += fmt::format("  largest relative change per iteration: {} (tolerance {:g})\n", listed, tolerance);
   }
-  out += fmt::format("  {:<14} {:>15} {:>13}   {:>31}   {:>15}\n", "parameter", "IV estimate", "std. error", "95% confidence interval",
-                     "equation error");
+  const bool units = std::any_of(groups.begin(), groups.end(), [](const auto& g) {
+    return std::any_of(g.parameters.begin(), g.parameters.end(), [](const auto& p) { return !p.unit.empty(); });
+  });
+  out += fmt::format("  {:<14} {:>15} {:>13}   {:>31}   {:>15}{}\n", "parameter", "IV estimate", "std. error", "95% confidence interval",
+                     "equation error", units ? "   unit" : "");
   for (const auto& g : groups)
     for (const auto& p : g.parameters)
-      out += fmt::format("  {:<14} {:>15.6g} {:>13.4g}   [{:>13.6g}, {:>13.6g}]   {:>15.6g}\n", p.name, p.value, p.standard_error, p.ci_low,
-                         p.ci_high, p.equation_error);
+      out += fmt::format("  {:<14} {:>15.6g} {:>13.4g}   [{:>13.6g}, {:>13.6g}]   {:>15.6g}{}\n", p.name, p.value, p.standard_error, p.ci_low,
+                         p.ci_high, p.equation_error, p.unit.empty() ? "" : "   " + p.unit);
   for (std::size_t g = 0; g < groups.size(); ++g)
     out += fmt::format("  {}n = {}, p = {}, residual s.d. of the IV residuals b - Phi theta = {:.4g}\n",
                        groups.size() > 1 ? fmt::format("group {}: ", g + 1) : std::string(), groups[g].n, groups[g].p, groups[g].residual_sd);
@@ -479,7 +483,7 @@ InstrumentalVariablesSummary instrumental_variables(const ir::Model& model, cons
     const double t = t_quantile(0.5 + iv_options.confidence_level / 2, static_cast<double>(out.n) - static_cast<double>(out.p));
     for (std::size_t c = 0; c < ee.parameters.size(); ++c) {
       const ParameterEstimate& e = ee.parameters[c];
-      InstrumentalVariablesParameter p{e.name, e.index, e.value, e.standard_error, e.ci_low, e.ci_high, e.value};
+      InstrumentalVariablesParameter p{e.name, e.index, e.value, e.standard_error, e.ci_low, e.ci_high, e.value, parameter_unit(model, e.name)};
       if (k > 0) {
         const auto i = static_cast<Index>(c);
         p.value = current[g](i);

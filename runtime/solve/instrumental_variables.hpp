@@ -53,6 +53,7 @@ struct InstrumentalVariablesParameter {
   std::optional<ParameterIndex> index;
   double value = 0, standard_error = 0, ci_low = 0, ci_high = 0;
   double equation_error = 0;  // the equation-error (least-squares) estimate, for comparison
+  std::string unit;           // as the fit table prints it; "" when the model gives none
 };
 
 struct InstrumentalVariablesGroup {

@@ -177,9 +177,10 @@ void add_select_command(CLI::App& app, int& exit_status) {
   add_record_options(cmd, a->records);
   cmd->add_option("--method", a->method, "exact (branch and bound), stlsq, frols, or automatic (exact up to 26 free candidates, else frols)")
       ->check(CLI::IsMember({"automatic", "exact", "stlsq", "frols"}));
-  cmd->add_option("--require", a->required, "A parameter kept in every subset (repeatable)");
-  cmd->add_option("--group", a->groups, "NAME=p1,p2,...: parameters that enter or leave together (repeatable)");
-  cmd->add_option("--drop", a->dropped, "A parameter removed before the search (repeatable)");
+  // One value per occurrence (or several, comma-separated): a word after it is never taken as a value.
+  cmd->add_option("--require", a->required, "Parameters kept in every subset (repeatable or comma-separated)")->allow_extra_args(false)->delimiter(',');
+  cmd->add_option("--group", a->groups, "NAME=p1,p2,...: parameters that enter or leave together (repeatable)")->allow_extra_args(false);
+  cmd->add_option("--drop", a->dropped, "Parameters removed before the search (repeatable or comma-separated)")->allow_extra_args(false)->delimiter(',');
   cmd->add_option("--folds", a->folds, "K for cross-validation over K contiguous time blocks (0 = off)")->check(CLI::Range(0, 1000));
   cmd->add_option("--bootstrap", a->bootstrap, "Bootstrap replicates over time blocks (0 = off)")->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", a->seed, "Seed of the bootstrap's random draws");

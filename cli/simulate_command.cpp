@@ -276,13 +276,18 @@ void add_simulate_command(CLI::App& app, int& exit_status) {
   CLI::App* cmd = app.add_subcommand("simulate", "Solve a model's equations with given parameter values (thesis section 2-4)");
   cmd->add_option("model", a->model, "Model file (.sid) or compiled model (.sidc.json)")->required();
   cmd->add_option("--params", a->params_file, "Parameter values from a fit (DIR/fit.json of `sidc fit --out DIR`; the refined ones when it was refined)");
-  cmd->add_option("--param", a->params, "Parameter values, NAME=VALUE ... (overrides --params)");
+  // One value per occurrence (or several, comma-separated): a word after it is never taken as a value.
+  cmd->add_option("--param", a->params, "Parameter values, NAME=VALUE, repeatable or comma-separated: --param a1=0.5,a2=3 (overrides --params)")
+      ->allow_extra_args(false)
+      ->delimiter(',');
   cmd->add_option("--data", a->data, "Record giving the time grid, the inputs and the initial state (default: the model's data statement)");
   cmd->add_option("--every", a->every, "Keep every K-th sample of the record")->check(CLI::PositiveNumber);
   cmd->add_option("--t0", a->t0, "Start time (default: the record's first sample, or 0)");
   cmd->add_option("--t1", a->t1, "End time (default: the record's last sample)");
   cmd->add_option("--step", a->step, "Output step, for a run without a record")->check(CLI::PositiveNumber);
-  cmd->add_option("--initial", a->initial, "Initial conditions, e.g. y=1 \"y'=0\" (default: from the record, else 0)");
+  cmd->add_option("--initial", a->initial, "Initial conditions, repeatable or comma-separated: --initial y=1,y'=0 (default: from the record, else 0)")
+      ->allow_extra_args(false)
+      ->delimiter(',');
   cmd->add_option("--method", a->method, "rk4 (fixed step, the thesis' solver) or adaptive")->check(CLI::IsMember({"rk4", "adaptive"}));
   cmd->add_option("--stepper", a->stepper, "For --method adaptive: dopri5 or cash_karp")->check(CLI::IsMember({"dopri5", "cash_karp"}));
   cmd->add_option("--substeps", a->substeps, "RK4 steps per sample interval (default 1)")->check(CLI::PositiveNumber);

@@ -28,7 +28,7 @@ def main():
         for i in range(100000):
             t = i * 0.01
             f.write(f"{t:.2f},{math.cos(1.1 * t) + 0.5 * math.sin(2.7 * t) + 0.3 * math.cos(0.37 * t)!r},0\n")
-    subprocess.run([sidc, "simulate", "truth.sid", "--data", "input.csv", "--param", *TRUTH.split(), "--initial", "y=0", "y'=0",
+    subprocess.run([sidc, "simulate", "truth.sid", "--data", "input.csv", "--param", ",".join(TRUTH.split()), "--initial", "y=0,y'=0",
                     "--substeps", "4", "-o", "sim.csv"], cwd=out, check=True, stdout=subprocess.DEVNULL)
     lines = open(os.path.join(out, "sim.csv")).read().split("\n")[1:]
     ys = [float(l.split(",")[1]) for l in lines if l]

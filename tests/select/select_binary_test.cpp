@@ -51,7 +51,7 @@ fs::path clean_record() {
     const fs::path csv = work() / "clean.csv";
     const SidcRun r = run_sidc("simulate " + shell_quoted(kModels / "truth.sid") +
                            " --param m=1 --param c1=0.4 --param k1=2 --param k3=0.5 --t0 0 --t1 30 --step 0.01"
-                           " --initial y=0.5 \"y'=0\" --substeps 10 -o " + shell_quoted(csv));
+                           " --initial \"y=0.5,y'=0\" --substeps 10 -o " + shell_quoted(csv));
     EXPECT_EQ(r.status, 0) << r.err;
     return csv;
   }();
@@ -216,7 +216,7 @@ TEST(SelectBinary, NoiseFreeRecordWhereCvOverfitsTheElbowFindsTheTrueOperations)
   // Van der Pol, integrated twice, no noise: G falls 15 orders of magnitude at the true six
   // parameters, then a few per cent per extra term fitted to the operators' smooth error, which
   // every held-out block shares: CV, AIC and BIC keep extra terms, the elbow stops.
-  const fs::path clean = simulated_record("truth_vanderpol.sid", "--param m=1 --param c=-1 --param d=1 --param k=1", "y=1 \"y'=0\"", 40);
+  const fs::path clean = simulated_record("truth_vanderpol.sid", "--param m=1 --param c=-1 --param d=1 --param k=1", "\"y=1,y'=0\"", 40);
   const auto j = select_json("candidates_vanderpol.sid", clean, "--require m");
   ASSERT_FALSE(j.is_discarded());
   const std::set<std::string> truth{"m", "c", "d", "k", "C1", "C2"};
@@ -237,7 +237,7 @@ TEST(SelectBinary, NoiseFreeRecordWhereCvOverfitsTheElbowFindsTheTrueOperations)
 TEST(SelectBinary, DriftAbsorberIsFlaggedAndSetAside) {
   // A pendulum within 0.35 rad, integrated twice: cos(y) is nearly 1, so int(int(cos(y))) is
   // nearly t^2/2 and can absorb the drift of the doubly integrated noise.
-  const fs::path clean = simulated_record("truth_pendulum.sid", "--param J=1 --param c=0.1 --param g=4", "y=0.3 \"y'=0\"", 40);
+  const fs::path clean = simulated_record("truth_pendulum.sid", "--param J=1 --param c=0.1 --param g=4", "\"y=0.3,y'=0\"", 40);
   const auto j = select_json("candidates_pendulum.sid", noisy_record(1e-3, clean), "--require J");
   ASSERT_FALSE(j.is_discarded());
   const auto& g = j["groups"][0];

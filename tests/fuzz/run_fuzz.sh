@@ -60,9 +60,10 @@ case "$kind" in
 esac
 echo "run_fuzz.sh: $(basename "$fuzzer"): $(find "$seeds" -type f -not -name .complete | wc -l) seeds, $seconds s"
 
-# -timeout: one input taking 25 s is a hang; -rss_limit_mb: more than 2 GB is a finding too.
+# -timeout: one input taking 25 s is a hang (SIDC_FUZZ_TIMEOUT on a machine busy with other work,
+# where a slow unit under ASan is not a hang); -rss_limit_mb: more than 2 GB is a finding too.
 status=0
-"$fuzzer" -max_total_time="$seconds" -timeout=25 -rss_limit_mb=2048 -max_len="$max_len" \
+"$fuzzer" -max_total_time="$seconds" -timeout="${SIDC_FUZZ_TIMEOUT:-25}" -rss_limit_mb=2048 -max_len="$max_len" \
   -print_final_stats=1 -artifact_prefix="$work_dir/findings/" "$work_dir/corpus" "$seeds" || status=$?
 if ((status != 0)); then
   echo "run_fuzz.sh: $(basename "$fuzzer") found a problem (exit $status); the input is in $work_dir/findings/" >&2

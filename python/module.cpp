@@ -135,6 +135,7 @@ std::vector<RecordInput> record_inputs(const py::object& data) {
   std::vector<RecordInput> out;
   if (data.is_none()) return out;
   if (py::isinstance<py::list>(data) || py::isinstance<py::tuple>(data)) {
+    if (py::len(data) == 0) type_error(cli_diag::not_a_record("an empty list (None reads the model's data statements)"));
     std::size_t k = 0;
     for (const auto& item : data) out.push_back(record_input(item, "<arrays " + std::to_string(++k) + ">"));
     return out;
@@ -300,7 +301,7 @@ FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& 
   s.records = record_settings(k);
   if (auto* v = k.get("integrate")) s.integrate = py::str(*v).cast<std::string>();  // 0..8 or "auto", checked as --integrate is
   k.text("form", s.form, {"derivative", "integrated", "weak"});
-  if (!s.form.empty() && !s.integrate.empty()) value_error(cli_diag::keyword_not_one_of("form", s.form, "None when `integrate` is given"));
+  if (!s.form.empty() && !s.integrate.empty()) value_error(cli_diag::invalid_options("`form` and `integrate` exclude each other (as `--form` and `--integrate` do): give one of them"));
   k.flag("no_validate", s.no_validate);
   if (auto* v = k.get("validate")) s.validate = record_inputs(*v);
   k.integer("validate_samples", s.validate_samples, 0);
@@ -412,12 +413,16 @@ py::tuple run_simulate(const ModelHandle& m, const py::dict& params, const py::o
     r.substeps = n;
   }
   k.number("tolerance", r.tolerance, true);
-  for (const auto& [name, value] : params) {
+  // One number per name, checked as a keyword of that name is (the message names the parameter).
+  auto number_of = [](const py::handle& name, const py::handle& value) {
+    const std::string n = py::str(name).cast<std::string>();
+    py::dict one;
+    one[py::str(n)] = value;
     std::optional<double> v;
-    const Keywords one("simulate", py::dict(py::arg("params") = value), {"params"});
-    one.number("params", v);
-    r.parameters.emplace_back(py::str(name).cast<std::string>(), *v);
-  }
+    Keywords("simulate", one, {n}).number(n, v);
+    return std::pair{n, *v};
+  };
+  for (const auto& [name, value] : params) r.parameters.push_back(number_of(name, value));
   r.time = values_of("t", t);
   if (!inputs.is_none()) {
     if (!py::isinstance<py::dict>(inputs)) type_error(cli_diag::keyword_wrong_type("inputs", type_name(inputs), "a dict of 1-D arrays"));
@@ -430,12 +435,7 @@ py::tuple run_simulate(const ModelHandle& m, const py::dict& params, const py::o
   }
   if (!initial.is_none()) {
     if (!py::isinstance<py::dict>(initial)) type_error(cli_diag::keyword_wrong_type("initial", type_name(initial), "a dict such as {\"y\": 1, \"y'\": 0}"));
-    for (const auto& [name, value] : py::reinterpret_borrow<py::dict>(initial)) {
-      std::optional<double> v;
-      const Keywords one("simulate", py::dict(py::arg("initial") = value), {"initial"});
-      one.number("initial", v);
-      r.initial.emplace_back(py::str(name).cast<std::string>(), *v);
-    }
+    for (const auto& [name, value] : py::reinterpret_borrow<py::dict>(initial)) r.initial.push_back(number_of(name, value));
   }
   std::variant<SimulationSummary, Failure> result;
   {

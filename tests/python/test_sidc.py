@@ -211,6 +211,11 @@ class BadInput(Workspace):
             model.fit({"t": np.zeros((3, 2))})
         with self.assertRaises(TypeError):
             model.fit(42)
+        with self.assertRaises(TypeError):
+            model.fit([])  # None, not an empty list, reads the model's data statements
+        with self.assertRaises(ValueError) as caught:
+            model.fit(self.csv, form="weak", integrate=1)
+        self.assertIn("exclude each other", str(caught.exception))
 
     def test_nan_in_a_record(self):
         record = {k: np.ascontiguousarray(v) for k, v in read_record(self.csv).items()}
@@ -321,6 +326,9 @@ class SelectAndSimulate(Workspace):
         self.assertIn("mass", str(caught.exception))
         with self.assertRaises(TypeError):
             sidc.simulate(model, {"m": 1.0}, None, t.astype(int))
+        with self.assertRaises(ValueError) as caught:
+            sidc.simulate(model, {"m": float("nan")}, None, t)
+        self.assertIn("`m` is nan, not a finite number", str(caught.exception))
 
 
 if __name__ == "__main__":

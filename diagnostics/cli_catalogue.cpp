@@ -265,4 +265,45 @@ Diagnostic simulation_stopped(std::string_view text) {
   return message("simulation-stopped", std::string(text), "check the parameter values and the initial state; the rows after the stop are NaN");
 }
 
+Diagnostic unknown_keyword(std::string_view function, std::string_view name, std::string_view nearest, std::string_view names) {
+  return message("unknown-keyword", fmt::format("`{}()` has no setting `{}`", function, name),
+                 nearest.empty() ? fmt::format("the settings are: {}", names)
+                                 : fmt::format("did you mean `{}`? (the settings are: {})", nearest, names));
+}
+
+Diagnostic keyword_not_one_of(std::string_view name, std::string_view value, std::string_view choices) {
+  return message("keyword-not-one-of", fmt::format("`{}={}` is not one of {}", name, value, choices));
+}
+
+Diagnostic keyword_wrong_type(std::string_view name, std::string_view given, std::string_view expected) {
+  return message("keyword-wrong-type", fmt::format("`{}` is {}, not {}", name, given, expected));
+}
+
+Diagnostic array_lengths_differ(std::string_view record, std::string_view column, std::size_t length, std::string_view first,
+                                std::size_t first_length) {
+  return message("array-lengths-differ",
+                 fmt::format("{}: column `{}` has {} values, column `{}` has {}", record, column, length, first, first_length),
+                 "every column of a record is sampled at the same instants: give arrays of one length");
+}
+
+Diagnostic array_not_float(std::string_view record, std::string_view column, std::string_view dtype) {
+  return message("array-not-float", fmt::format("{}: column `{}` holds {}, not floating-point numbers", record, column, dtype),
+                 fmt::format("convert it, e.g. `{}.astype(float)`; float64 arrays are used without a conversion", column));
+}
+
+Diagnostic array_not_one_dimensional(std::string_view record, std::string_view column, std::size_t dimensions) {
+  return message("array-not-one-dimensional", fmt::format("{}: column `{}` is a {}-dimensional array, not a 1-D one", record, column, dimensions),
+                 "give each signal as its own 1-D array, e.g. {\"t\": t, \"y\": y}");
+}
+
+Diagnostic record_without_columns(std::string_view record) {
+  return message("record-without-columns", fmt::format("{}: the record has no columns", record),
+                 "give a dict of 1-D arrays named like the model's signals, e.g. {\"t\": t, \"x\": x, \"y\": y}");
+}
+
+Diagnostic not_a_record(std::string_view given) {
+  return message("not-a-record", fmt::format("a record is a CSV path or a dict of 1-D arrays, not {}", given),
+                 "give a path, a dict of arrays, or a list of either (several records)");
+}
+
 }  // namespace sidc::cli_diag

@@ -99,4 +99,19 @@ Diagnostic too_many_output_rows(double count, double step, double t0, double t1)
 Diagnostic input_without_values(std::string_view input);
 Diagnostic simulation_stopped(std::string_view message);
 
+// ---- the Python module (python/): keyword settings and numpy records -----------------------------
+// Its keyword arguments are the command line's options (`every=2` is `--every 2`), so they are
+// reported like options; its records are dicts of 1-D arrays named like a CSV's columns.
+// `function` is e.g. `fit`; `nearest` the closest keyword ("" when none is close), `names` all.
+Diagnostic unknown_keyword(std::string_view function, std::string_view name, std::string_view nearest, std::string_view names);
+Diagnostic keyword_not_one_of(std::string_view name, std::string_view value, std::string_view choices);
+Diagnostic keyword_wrong_type(std::string_view name, std::string_view given, std::string_view expected);
+// `record` names the record (`<arrays>`, `<arrays 2>`); columns by their key.
+Diagnostic array_lengths_differ(std::string_view record, std::string_view column, std::size_t length, std::string_view first,
+                                std::size_t first_length);
+Diagnostic array_not_float(std::string_view record, std::string_view column, std::string_view dtype);
+Diagnostic array_not_one_dimensional(std::string_view record, std::string_view column, std::size_t dimensions);
+Diagnostic record_without_columns(std::string_view record);
+Diagnostic not_a_record(std::string_view given);
+
 }  // namespace sidc::cli_diag

@@ -268,14 +268,7 @@ std::vector<std::string> fit_file_paths(const std::string& directory) {
 
 std::string select_file_path(const std::string& directory) { return (fs::path(directory) / "select.json").string(); }
 
-std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& f) {
-  std::error_code ec;
-  fs::create_directories(directory, ec);
-  if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
-  const auto paths = fit_file_paths(directory);
-  const std::string& json_path = paths[0];
-  const std::string& csv_path = paths[1];
-  const std::string& validation_path = paths[2];
+nlohmann::ordered_json fit_document(const FitFiles& f) {
   auto json = fit_json(f.summary, f.compiled, f.compiled_path, f.options);
   if (f.validation) json["validation"] = validation_json(*f.validation, f.records.size());
   json["residual_analysis"] = residual_json(f.residuals);
@@ -291,11 +284,23 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   json["form_choice"] = std::move(choice);
   json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
   json["instrumental_variables"] = f.instrumental_variables ? instrumental_variables_json(*f.instrumental_variables) : nlohmann::ordered_json(nullptr);
+  non_finite_as_strings(json);
+  return json;
+}
+
+std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& f) {
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
+  const auto paths = fit_file_paths(directory);
+  const std::string& json_path = paths[0];
+  const std::string& csv_path = paths[1];
+  const std::string& validation_path = paths[2];
+  const auto json = fit_document(f);
   const bool curves = f.validation && !f.validation->runs.empty();
   std::string why;
   std::optional<Diagnostic> problem;  // why the residual rows could not be had
   const ir::Model& model = f.compiled.integrated;
-  non_finite_as_strings(json);
   // One set, renamed in together once every file is whole: a failure leaves the previous run's
   // files as they were, and a validation.csv this run does not write is removed with the commit
   // (it would read as this fit's).

@@ -58,6 +58,11 @@ struct FitFiles {
   const InstrumentalVariablesSummary* instrumental_variables = nullptr;
 };
 
+// The whole of fit.json (the fit, validation, residual analysis, form choice, refinement and
+// instrumental variables; non-finite numbers as strings): what write_fit_files writes, and what the
+// Python module's `to_json()` returns.
+nlohmann::ordered_json fit_document(const FitFiles& files);
+
 // Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating
 // DIR); the paths written, or the Diagnostic of the first failure (the previous files untouched).
 // A validation.csv of an earlier run is removed when this run writes none.

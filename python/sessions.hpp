@@ -1,0 +1,125 @@
+// What the Python module's `fit`, `select` and `simulate` do, in plain C++ (no Python here): the
+// same sequence of library calls as `sidc fit`, `sidc select` and `sidc simulate` (cli/*_command.cpp),
+// with the records given as CSV paths or as records already in memory (numpy arrays, converted by
+// python/module.cpp), and results kept instead of printed.
+//
+// Relies on: compiler/ (the model, its forms), runtime/ (records, fit, validation, refinement,
+// selection, simulation), report/ (the text report and fit.json, report/fit_files.hpp). The command
+// line's option names are the settings' field names (`--validate-samples` is `validate_samples`).
+// Guarantees: every problem the CLI reports comes back as its Diagnostics, with the same wording,
+// never as an exception or a crash; nothing is written to a file, stdout or stderr; nothing here
+// touches Python, so the module runs these with the interpreter lock released.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "diagnostics/diagnostic.hpp"
+#include "ir/compiled_model.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/refine/refine.hpp"
+#include "runtime/select/select.hpp"
+#include "runtime/simulate/form_choice.hpp"
+#include "runtime/simulate/simulate.hpp"
+#include "runtime/simulate/validate.hpp"
+#include "runtime/solve/fit.hpp"
+#include "runtime/solve/instrumental_variables.hpp"
+#include "runtime/solve/residual_analysis.hpp"
+
+namespace sidc::python {
+
+// A model as the module holds it: compiled, with where it came from (relative data statements are
+// taken from `directory`, as `sidc fit` takes them from the model file's folder).
+struct LoadedModel {
+  CompiledModel compiled;
+  std::string path;       // the model file, or `<string>` for text
+  std::string directory;  // for relative data paths
+};
+
+// One record: a CSV path (read as `--data` reads it) or a record already in memory.
+using RecordInput = std::variant<std::string, Record>;
+
+// The options `sidc fit` and `sidc select` share (cli/record_options.hpp), by their option names.
+struct RecordSettings {
+  std::optional<double> from, to, step, resample;
+  std::optional<int> every;
+  std::string derivative, second_derivative, edges, integration, precision, weights;
+};
+
+struct FitSettings {
+  RecordSettings records;
+  std::string integrate, form;  // --integrate N|auto, --form derivative|integrated|weak
+  bool no_validate = false;
+  std::vector<RecordInput> validate;  // records only compared with
+  std::size_t validate_samples = 100000;
+  std::string initial_state = "estimate";
+  bool refine = false;
+  std::string estimator;  // "", least_squares, iv
+};
+
+struct SelectSettings {
+  RecordSettings records;
+  std::string method = "automatic", rule = "elbow";
+  std::vector<std::string> required, dropped;
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups;
+  int folds = 5, bootstrap = 0, max_size = -1;
+  std::uint64_t seed = 1;
+  bool simulate = false, keep_drift = false;
+  std::size_t simulate_samples = 100000;
+};
+
+// Everything one fit produced, kept for the result's properties.
+struct FitSession {
+  LoadedModel model;  // its `integrated` is the form fitted
+  FitOptions options;
+  std::vector<SampledRecord> records;
+  std::optional<FormChoice> form_choice;
+  FitSummary summary;
+  std::optional<InstrumentalVariablesSummary> instrumental_variables;
+  std::optional<RefineSummary> refinement;
+  std::optional<FitValidation> validation;
+  ResidualAnalysis residuals;
+  std::string report;                  // what `sidc fit` prints on stdout
+  std::vector<std::string> warnings;   // what it prints on stderr, rendered, one per entry
+};
+
+// Failure: the Diagnostics the CLI would print (one or several, e.g. an --integrate rewrite).
+using Failure = std::vector<Diagnostic>;
+
+// `model` is copied in (the session keeps its own, rewritten into the fitted form).
+std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel& model, std::vector<RecordInput> records, FitSettings settings);
+
+// fit.json's content (report/fit_files.hpp: fit_document).
+nlohmann::ordered_json fit_json_document(const FitSession& session);
+
+// Every group's rows: group and equation (1-based), record (0-based), t, known, fitted, residual, as
+// residuals.csv holds them (a streamed fit's rows are evaluated again, block by block).
+struct ResidualColumns {
+  std::vector<double> group, equation, record, time, known, fitted, residual;
+};
+std::variant<ResidualColumns, Diagnostic> residual_columns(const FitSession& session);
+
+struct SelectResult {
+  nlohmann::ordered_json document;  // select.json's content
+  std::string report;               // what `sidc select` prints on stdout
+  std::vector<std::string> warnings;
+};
+std::variant<SelectResult, Failure> select_session(const LoadedModel& model, std::vector<RecordInput> records, const SelectSettings& settings);
+
+struct SimulateRequest {
+  std::vector<std::pair<std::string, double>> parameters;  // by name, every parameter of the model
+  std::vector<std::pair<std::string, double>> initial;     // "y", "y'", ...: 0 when not given
+  std::vector<double> time;
+  std::map<std::string, std::vector<double>> inputs;       // on `time`
+  std::string method = "rk4", stepper = "dopri5";
+  std::optional<int> substeps;
+  std::optional<double> tolerance;
+};
+std::variant<SimulationSummary, Failure> simulate_session(const LoadedModel& model, SimulateRequest request);
+
+}  // namespace sidc::python

@@ -174,7 +174,7 @@ std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel
   for (const auto& w : statistics_warnings(model, summary)) s->warnings.push_back(render(w));
   std::string& report = s->report;
   report = fmt::format("sidc fit: model `{}` ({})\n\n", model.name, loaded.path) + form_report + (form_report.empty() ? "" : "\n") +
-           operator_report(summary.operators, o.evaluation);
+           operator_report(summary.operators, o.evaluation, model);
   if (!is_static(model)) report += "\n";
   report += summary.full_report(model);
 

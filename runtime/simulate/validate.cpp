@@ -87,10 +87,16 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
   run.start = start;
   run.truncated = static_cast<std::size_t>(to) < record.time.size();
+  double largest = 0;
   for (const auto& out : form.outputs) {
     const auto& column = record.signals.at(out.name);
     run.recorded.emplace_back(column.begin() + from, column.begin() + to);
+    for (double v : run.recorded.back())
+      if (std::isfinite(v)) largest = std::max(largest, std::abs(v));
   }
+  // Divergence is judged against the record's own size: a record in units where it reaches 1e9
+  // (joules, pascals) is not a diverging solution.
+  run.options.divergence_bound = std::max(run.options.divergence_bound, 1e6 * largest);
   return run;
 }
 
@@ -132,18 +138,25 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
       mean += y[i];
     }
     if (r.samples) mean /= static_cast<double>(r.samples);
+    // Squares taken relative to the largest error or deviation, so that a record in units of 1e200
+    // (or 1e-200) gives the same fit % and a finite RMS error.
+    double scale = 0;
+    for (std::size_t i = 0; i < y.size(); ++i)
+      if (std::isfinite(e[i])) scale = std::max({scale, std::abs(e[i]), std::abs(y[i] - mean)});
     for (std::size_t i = 0; i < y.size(); ++i) {
       if (!std::isfinite(e[i])) continue;
       max_observed = std::max(max_observed, std::abs(y[i]));
       if (std::abs(e[i]) > r.max_abs_error) r.max_abs_error = std::abs(e[i]), r.time_of_max = o.time[i];
-      sum_e2 += e[i] * e[i];
-      sum_d2 += (y[i] - mean) * (y[i] - mean);
+      if (scale == 0) continue;
+      sum_e2 += (e[i] / scale) * (e[i] / scale);
+      sum_d2 += ((y[i] - mean) / scale) * ((y[i] - mean) / scale);
     }
     r.percent_error = max_observed > 0 ? 100 * r.max_abs_error / max_observed : NAN;  // eq. 4-1.5
-    r.fit_percent = sum_d2 > 0 ? 100 * (1 - std::sqrt(sum_e2 / sum_d2)) : NAN;
-    r.rms_error = r.samples ? std::sqrt(sum_e2 / static_cast<double>(r.samples)) : NAN;
+    // No error at all is a fit of 100%, also of a constant record (whose spread is 0).
+    r.fit_percent = r.samples && sum_e2 == 0 ? 100 : sum_d2 > 0 ? 100 * (1 - std::sqrt(sum_e2 / sum_d2)) : NAN;
+    r.rms_error = r.samples ? scale * std::sqrt(sum_e2 / static_cast<double>(r.samples)) : NAN;
     r.follows = v.simulation.completed() && r.fit_percent >= kFollowsFitPercent;
-    const double spread = r.samples ? std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;
+    const double spread = r.samples ? scale * std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;
     r.departs_at = departure(e, o.time, kDepartureShare * spread);
     if (!r.departs_at && !v.simulation.completed()) r.departs_at = v.simulation.stopped_at;
     v.outputs.push_back(r);

@@ -87,16 +87,10 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
   run.start = start;
   run.truncated = static_cast<std::size_t>(to) < record.time.size();
-  double largest = 0;
   for (const auto& out : form.outputs) {
     const auto& column = record.signals.at(out.name);
     run.recorded.emplace_back(column.begin() + from, column.begin() + to);
-    for (double v : run.recorded.back())
-      if (std::isfinite(v)) largest = std::max(largest, std::abs(v));
   }
-  // Divergence is judged against the record's own size: a record in units where it reaches 1e9
-  // (joules, pascals) is not a diverging solution.
-  run.options.divergence_bound = std::max(run.options.divergence_bound, 1e6 * largest);
   return run;
 }
 
@@ -152,8 +146,10 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
       sum_d2 += ((y[i] - mean) / scale) * ((y[i] - mean) / scale);
     }
     r.percent_error = max_observed > 0 ? 100 * r.max_abs_error / max_observed : NAN;  // eq. 4-1.5
-    // No error at all is a fit of 100%, also of a constant record (whose spread is 0).
-    r.fit_percent = r.samples && sum_e2 == 0 ? 100 : sum_d2 > 0 ? 100 * (1 - std::sqrt(sum_e2 / sum_d2)) : NAN;
+    // A whole run without any error is a fit of 100%, also on a constant record (whose spread is 0).
+    r.fit_percent = v.simulation.completed() && r.samples && sum_e2 == 0 ? 100
+                    : sum_d2 > 0                                      ? 100 * (1 - std::sqrt(sum_e2 / sum_d2))
+                                                                      : NAN;
     r.rms_error = r.samples ? scale * std::sqrt(sum_e2 / static_cast<double>(r.samples)) : NAN;
     r.follows = v.simulation.completed() && r.fit_percent >= kFollowsFitPercent;
     const double spread = r.samples ? scale * std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;

@@ -215,6 +215,14 @@ struct Reader {
     if (*kind == FactorKind::initial_value && !j.at("at").is_null()) f.at = number(j.at("at"));
     if (j.contains("exponent")) f.exponent = number(j.at("exponent"));
     if (j.contains("argument")) f.argument = sum_ptr(j.at("argument"));
+    // What every pass after the reader takes for granted (the fuzzer found a function without its
+    // argument reaching the unit pass): checked here, once.
+    const bool takes_argument = *kind == FactorKind::function || *kind == FactorKind::power || *kind == FactorKind::derivative ||
+                                *kind == FactorKind::integral;
+    if (takes_argument && !f.argument) throw std::runtime_error(fmt::format("a `{}` factor without its argument", kind_name(*kind)));
+    if (*kind == FactorKind::power && !j.contains("exponent")) throw std::runtime_error("a `power` factor without its exponent");
+    static const std::set<std::string> functions{"sin", "cos", "exp", "log", "sqrt", "abs", "sign", "tanh"};
+    if (*kind == FactorKind::function && !functions.count(f.name)) throw std::runtime_error("an unknown function `" + f.name + "`");
     if (*kind == FactorKind::guard)
       for (const auto& c : j.at("conditions")) {
         const std::string r = c.at("relation").get<std::string>();

@@ -456,6 +456,16 @@ TEST(CompiledModelFile, ReaderRefusesBrokenFilesWithAMessage) {
       {"a span past the end of the source text", [](json& j) { j["equations"][0]["span"] = {{"offset", 5}, {"length", 1u << 30}}; },
        {"a span outside the source text"}},
       {"a negative span offset", [](json& j) { j["equations"][0]["span"] = {{"offset", -3}, {"length", 1}}; }, {"`offset` is ", ", not an integer that fits"}},
+      // Found by the compiled-model fuzz target (an hour-long run): a function factor whose
+      // `argument` key was misspelt reached the unit pass as a null pointer.
+      {"a function without its argument", [&](json& j) { j[first_factor] = {{"kind", "function"}, {"name", "sin"}, {"asgument", nullptr}, {"power", 1}}; },
+       {"a `function` factor without its argument"}},
+      {"a power without its exponent", [&](json& j) {
+         j[first_factor] = {{"kind", "power"}, {"argument", {{"text", "y"}, {"terms", json::array()}}}, {"power", 1}};
+       }, {"a `power` factor without its exponent"}},
+      {"an unknown function", [&](json& j) {
+         j[first_factor] = {{"kind", "function"}, {"name", "sinh"}, {"argument", {{"text", "y"}, {"terms", json::array()}}}, {"power", 1}};
+       }, {"an unknown function `sinh`"}},
       {"a derivative order past the compiler's 64", [&](json& j) {
          j[first_factor]["kind"] = "signal", j[first_factor]["name"] = "y", j[first_factor]["order"] = 65;
        }, {"derivative order of 65"}},

@@ -348,8 +348,10 @@ bool write_fit_pictures(const PictureContext& context, const PictureRequest& req
   }
   const ScratchFolder scratch;
   if (scratch.path().empty()) {
-    error = render(cli_diag::cannot_create_directory(fs::temp_directory_path(ec).string(), std::strerror(errno),
-                                                     "set TMPDIR to a folder you can write to"));
+    const int why_not = errno;
+    const char* tmpdir = std::getenv("TMPDIR");
+    const std::string where = (tmpdir && *tmpdir ? std::string(tmpdir) : std::string("/tmp")) + "/sidc-figures.XXXXXX";
+    error = render(cli_diag::cannot_create_directory(where, std::strerror(why_not), "set TMPDIR to a folder you can write to"));
     return false;
   }
   ReportContent content = report_content(context);

@@ -49,21 +49,24 @@ std::vector<std::span<const double>> pieces_of(std::span<const double> y) {
 
 }  // namespace
 
-NoiseLevel estimate_noise_level(std::span<const double> y) {
-  NoiseLevel level;
-  level.samples = y.size();
-  if (y.empty()) return level;
+double standard_deviation(std::span<const double> y) {
+  if (y.empty()) return 0;
   double mean = 0;
   for (double v : y) mean += v;
   mean /= static_cast<double>(y.size());
-  // Squares taken relative to the largest deviation, so that a record in units of 1e200 has a
-  // finite spread (its squares would overflow).
   double largest = 0;
   for (double v : y) largest = std::max(largest, std::abs(v - mean));
   double ss = 0;
   if (largest > 0)
     for (double v : y) ss += ((v - mean) / largest) * ((v - mean) / largest);
-  level.spread = largest * std::sqrt(ss / static_cast<double>(y.size()));
+  return largest * std::sqrt(ss / static_cast<double>(y.size()));
+}
+
+NoiseLevel estimate_noise_level(std::span<const double> y) {
+  NoiseLevel level;
+  level.samples = y.size();
+  if (y.empty()) return level;
+  level.spread = standard_deviation(y);
   level.constant = std::all_of(y.begin(), y.end(), [&](double v) { return v == y.front(); });
   if (level.constant || y.size() < 3) return level;
 

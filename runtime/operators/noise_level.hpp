@@ -47,4 +47,8 @@ struct NoiseLevel {
 // samples: sigma 0, difference_order 0.
 NoiseLevel estimate_noise_level(std::span<const double> samples);
 
+// The standard deviation of the samples (divided by n), with squares taken relative to the
+// largest deviation: finite and non-zero for a record in units of 1e200 or 1e-200 alike.
+double standard_deviation(std::span<const double> samples);
+
 }  // namespace sidc

@@ -4,6 +4,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <span>
+
+#include "runtime/operators/noise_level.hpp"
 
 namespace sidc {
 namespace {
@@ -21,15 +24,8 @@ class StartProblem {
     for (auto& [name, values] : options_.inputs) values.resize(segment);
     const double duration = options_.time.back() - options_.time.front();
     for (std::size_t j = 0; j < form.outputs.size(); ++j) {
-      double mean = 0, largest = 0, squares = 0;
-      for (std::size_t i = 0; i < segment; ++i) mean += recorded[j][i];
-      mean /= static_cast<double>(segment);
-      // Relative to the largest deviation: a record in units of 1e200 (or 1e-200) has a finite,
-      // non-zero spread, and the residuals below are of order 1 in any unit.
-      for (std::size_t i = 0; i < segment; ++i) largest = std::max(largest, std::abs(recorded[j][i] - mean));
-      if (largest > 0)
-        for (std::size_t i = 0; i < segment; ++i) squares += ((recorded[j][i] - mean) / largest) * ((recorded[j][i] - mean) / largest);
-      const double sd = largest * std::sqrt(squares / static_cast<double>(segment));
+      // Finite and non-zero in any unit, so the residuals below are of order 1.
+      const double sd = standard_deviation(std::span<const double>(recorded[j].data(), segment));
       scale_.push_back(sd > 0 && std::isfinite(sd) ? sd : 1.0);
       // A typical size of y^(m) for the finite-difference steps: the spread over the segment's duration^m.
       for (int m = 0; m < form.outputs[j].order; ++m) {

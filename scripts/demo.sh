@@ -13,17 +13,19 @@ bash "$repo_root/scripts/setup.sh"
 sidc="$repo_root/build/cli/sidc"
 [[ -x "$sidc" ]] || { echo "demo.sh: error: $sidc was not built" >&2; exit 1; }
 
-# Each example: `sidc compile MODEL && sidc fit --plots DIR --report DIR/report.html`, pictures
+# Each example: `sidc compile MODEL && sidc fit MODEL.sidc.json --plots DIR --report DIR/report.html`, pictures
 # (SVG and PNG, drawn by gnuplot) into build/pictures/<example>/.
 pictures="$repo_root/build/pictures"
 run_example() {  # folder, model, step number, [pictures folder: the example's folder by default]
   local folder=$1 model=$2 step=$3 name=${4:-$1}
   local out="$pictures/$name"
   cd "$repo_root/examples/$folder"
-  echo "demo.sh: step $step of 5: sidc compile $model && sidc fit --plots $out (in examples/$folder)"
+  # The compiled model is named: a folder with two examples holds two (plain `sidc fit` refuses).
+  local compiled=${model%.sid}.sidc.json
+  echo "demo.sh: step $step of 5: sidc compile $model && sidc fit $compiled --plots $out (in examples/$folder)"
   "$sidc" compile "$model"
   rm -rf "$out"
-  "$sidc" fit --plots "$out" --report "$out/report.html"
+  "$sidc" fit "$compiled" --plots "$out" --report "$out/report.html"
 }
 run_example thesis-4-1 quasi_linear.sid 1
 run_example thesis-4-2 process.sid 2

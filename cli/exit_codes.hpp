@@ -4,6 +4,8 @@
 #include <iostream>
 #include <string>
 
+#include "driver/failure.hpp"
+
 namespace sidc::exit_code {
 inline constexpr int success = 0;
 inline constexpr int user_error = 1;      // the model, a data file or a compiled model is wrong: see stderr
@@ -16,5 +18,10 @@ namespace sidc {
 inline int fail(const std::string& message, int code) {
   std::cerr << message << "\n";
   return code;
+}
+// A failed step of the driver (driver/failure.hpp) the same way: each diagnostic, then its code.
+inline int fail(const driver::Failure& failure) {
+  for (const auto& d : failure.diagnostics) std::cerr << render(d) << "\n";
+  return failure.bad_setting ? exit_code::usage_error : exit_code::user_error;
 }
 }  // namespace sidc

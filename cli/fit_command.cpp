@@ -1,9 +1,9 @@
 // `sidc fit` (see fit_command.hpp): parses the options, calls the library and prints.
 //
-// The work is elsewhere: compiler/load_model.hpp loads the model, cli/record_options.hpp the
-// records, runtime/solve/fit.hpp fits, runtime/simulate/validate.hpp validates (thesis section
-// 2-4), runtime/solve/residual_analysis.hpp tests the residuals, runtime/solve/model_comparison.hpp
-// ranks several models, and report/ writes every file, picture and table.
+// The work is elsewhere: compiler/load_model.hpp loads the model, driver/fit_run.hpp makes the fit
+// (form, records, fit, instrumental variables, refinement, validation and residual tests, as the
+// Python module does), runtime/solve/model_comparison.hpp ranks several models, and report/ writes
+// every file and picture.
 #include "cli/fit_command.hpp"
 
 #include <algorithm>
@@ -17,26 +17,14 @@
 #include "cli/form_options.hpp"
 #include "cli/output_check.hpp"
 #include "cli/record_options.hpp"
-#include "compiler/hold_check_pass.hpp"
-#include "compiler/integrate_pass.hpp"
-#include "compiler/weak_pass.hpp"
 #include "compiler/load_model.hpp"
-#include "compiler/pipeline.hpp"
 #include "diagnostics/cli_catalogue.hpp"
-#include "ir/queries.hpp"
-#include "ir/settings.hpp"
+#include "driver/fit_run.hpp"
 #include "report/atomic_file.hpp"
 #include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
-#include "runtime/refine/refine.hpp"
-#include "runtime/simulate/form_choice.hpp"
-#include "runtime/simulate/validate.hpp"
-#include "runtime/solve/fit.hpp"
-#include "runtime/solve/fitted_values.hpp"
-#include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/model_comparison.hpp"
-#include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc {
 namespace {
@@ -77,142 +65,36 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   auto compiled = load_compiled_model(compiled_path, error, warnings);
   std::cerr << warnings;
   if (!compiled) return fail(error, exit_code::user_error);
-  if (request) {
-    // --integrate/--form: every equation rewritten as `sidc compile` with the same option would.
-    IntegrateOptions rewrite;
-    rewrite.override_request = request;
-    Diagnostics problems;
-    ir::Model m = weak_pass(integrate_pass(compiled->normalized, rewrite, problems), problems);
-    hold_check_pass(m, problems);
-    std::cerr << problems.render_all();
-    if (problems.has_errors()) return exit_code::user_error;
-    m.form_from_data = false;
-    compiled->integrated = std::move(m);
-  }
-  auto options = fit_options(compiled->integrated, a.records, error);
-  if (!options) return fail(error, exit_code::usage_error);
-  auto loaded = load_records(*compiled, compiled_path, a.records, error);
-  if (!loaded) return fail(error, exit_code::user_error);
+  driver::FitSettings settings;
+  settings.records = a.records.settings;
+  settings.form = request;
+  settings.no_validate = a.no_validate;
+  settings.validate.assign(a.validate.begin(), a.validate.end());
+  settings.validate_samples = a.validate_samples;
+  settings.initial_state = a.initial_state == "record" ? InitialState::record : InitialState::estimate;
+  settings.refine = a.refine;
+  settings.estimator = a.estimator;
+  const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; }};
+  auto prepared = driver::prepare_fit(std::move(*compiled), compiled_path, fs::path(compiled_path).parent_path().string(), record_inputs(a.records),
+                                      std::move(settings), print);
+  if (auto* f = std::get_if<driver::Failure>(&prepared)) return fail(*f);
+  driver::FitRun& run = *std::get<std::unique_ptr<driver::FitRun>>(prepared);
   {  // Before any work: no output may overwrite the model, its source or a record.
-    std::vector<std::string> inputs{compiled_path, (fs::path(compiled_path).parent_path() / fs::path(compiled->source->name).filename()).string()};
-    for (const auto& s : loaded->sources) inputs.push_back(s.path);
+    std::vector<std::string> inputs{compiled_path, (fs::path(compiled_path).parent_path() / fs::path(run.compiled.source->name).filename()).string()};
+    for (const auto& s : run.loaded.sources) inputs.push_back(s.path);
     std::vector<std::string> outputs = out_dir.empty() ? std::vector<std::string>{} : fit_file_paths(out_dir);
     outputs.push_back(a.report);
     for (const auto& output : outputs)
       if (const auto input = input_overwritten_by(output, inputs); !input.empty())
         return fail(render(cli_diag::output_is_input(output, input)), exit_code::usage_error);
   }
-  const std::vector<SampledRecord>& records = loaded->records;
-  std::string form_report;
-  std::optional<FormChoice> choice;
-  if (compiled->integrated.form_from_data) {
-    // The model names no form: each is fitted, and the weak form, the most accurate on known-truth
-    // records (docs/accuracy.md), is kept unless another's solved equations follow the record better
-    // on every piece of it (form_choice.hpp). Without validation there is nothing to judge them by.
-    if (a.no_validate) {
-      form_report = "form: weak, the most accurate on known-truth records (docs/accuracy.md); the model sets none, and with\n"
-                    "--no-validate there is no simulation to choose one by\n";
-      compiled->integrated = rewritten_in_form(compiled->normalized, "weak");
-    } else {
-      static const std::vector<std::string> forms{"weak", "derivative", "integrated"};
-      std::vector<ir::Model> rewritten;
-      std::vector<FormCandidate> candidates;
-      // A form that leaves a derivative of a held input (the derivative form of `x'`) is no candidate.
-      std::vector<std::string> names;
-      Diagnostics held;
-      for (const auto& f : forms) {
-        ir::Model m = rewritten_in_form(compiled->normalized, f);
-        if (!hold_check_pass(m, held)) continue;
-        rewritten.push_back(std::move(m));
-        names.push_back(f);
-      }
-      for (std::size_t i = 0; i < names.size(); ++i) candidates.push_back({names[i], &rewritten[i]});
-      choice = choose_form(candidates, compiled->normalized, *compiled->explicit_form, records, *options, a.validate_samples);
-      form_report = choice->report();
-      compiled->integrated = std::move(rewritten[choice->chosen]);
-    }
-  }
-  const ir::Model& model = compiled->integrated;
-
-  auto result = fit(model, records, *options);
-  if (auto* d = std::get_if<Diagnostic>(&result)) return fail(render(*d), exit_code::user_error);
-  const FitSummary& summary = std::get<FitSummary>(result);
-  for (const auto& r : summary.operators)
-    for (const auto& w : r.warnings) std::cerr << render(w) << "\n";
-  for (const auto& g : summary.groups)
-    for (const auto& warning : drift_warnings(model, g.drift)) std::cerr << render(warning) << "\n";
-  for (const auto& warning : statistics_warnings(model, summary)) std::cerr << render(warning) << "\n";
-  std::cout << fmt::format("sidc fit: model `{}` ({})\n\n", model.name, compiled_path) << form_report << (form_report.empty() ? "" : "\n")
-            << operator_report(summary.operators, options->evaluation, model);
-  if (!is_static(model)) std::cout << "\n";
-  std::cout << summary.full_report(model);
-  // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;
-  // validation solves with its estimate (or the refined one); residual tests and pictures stay
-  // those of the equation-error fit.
-  std::optional<InstrumentalVariablesSummary> iv;
-  if (a.estimator.empty() ? estimator_setting(model.settings) == Estimator::instrumental_variables : a.estimator == "iv") {
-    iv = instrumental_variables(model, compiled->normalized, *compiled->explicit_form, records, *options, summary);
-    std::cout << "\n" << iv->full_report();
-    if (!iv->is_solution_usable()) std::cerr << render(cli_diag::instrumental_variables_not_converged(iv->statement)) << "\n";
-  }
-
-  // The estimate the fit stands by, in the derivative form's parameters: the IV one when it was
-  // asked for and usable, else the equation-error one. Refinement starts from it.
-  const std::vector<double> fitted_estimate =
-      iv && iv->is_solution_usable() ? instrumental_parameter_values(compiled->normalized, *iv, fitted_parameter_values(compiled->normalized, summary, 0.0))
-                                     : fitted_parameter_values(compiled->normalized, summary, 0.0);
-
-  // Output-error refinement (issue 15): from that estimate, the parameters whose solved equations
-  // reproduce the fitted records best. A failure keeps the estimate it started from and says so.
-  std::optional<RefineSummary> refinement;
-  if ((a.refine || refine_by_simulation(compiled->normalized.settings)) && summary.is_solution_usable()) {
-    if (auto* d = std::get_if<Diagnostic>(&*compiled->explicit_form)) {
-      refinement.emplace();
-      refinement->message = "the equations cannot be solved for their highest derivatives (" + d->message + "); the equation-error estimate is kept";
-    } else {
-      RefineOptions ro;
-      ro.evaluation = options->evaluation;
-      ro.max_samples = a.validate_samples;
-      ro.from = options->from;
-      ro.to = options->to;
-      std::vector<const SampledRecord*> fitted;
-      for (const auto& r : records) fitted.push_back(&r);
-      auto refined = refine(compiled->normalized, std::get<ExplicitForm>(*compiled->explicit_form), fitted_estimate, fitted, ro);
-      if (auto* problem = std::get_if<Diagnostic>(&refined)) return fail(render(*problem), exit_code::user_error);
-      refinement = std::get<RefineSummary>(std::move(refined));
-    }
-    std::cout << "\n" << refinement->report();
-    if (!refinement->improved()) std::cerr << "sidc fit: warning: not refined: " << refinement->message << "\n";
-  }
-
-  std::optional<FitValidation> validation;
-  if (!a.no_validate) {
-    // The fitted records, then those given only to be compared with (not copied: records can be long).
-    std::vector<SampledRecord> extra;
-    for (const auto& path : a.validate) {
-      auto record = load_record(model, path, loaded->bind, error);
-      if (!record) return fail(error, exit_code::user_error);
-      extra.push_back(std::move(*record));
-    }
-    std::vector<const SampledRecord*> checked;
-    for (const auto& r : records) checked.push_back(&r);
-    for (const auto& r : extra) checked.push_back(&r);
-    validation = validate_fit(compiled->normalized, *compiled->explicit_form, summary, checked, records.size(), options->evaluation,
-                              a.validate_samples, a.initial_state == "record" ? InitialState::record : InitialState::estimate,
-                              refinement && refinement->improved() ? &refinement->values
-                              : iv && iv->is_solution_usable()      ? &fitted_estimate
-                                                                    : nullptr,
-                              refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables");
-    if (validation->failed_record)
-      return fail(render(cli_diag::cannot_validate(validation->failed_path, *validation->failed_record)), exit_code::user_error);
-    std::cout << validation_report(*validation, records.size());
-  }
-  const ResidualAnalysis residuals = analyse_residuals(model, summary, records, *options);
-  std::cout << residual_report(residuals);
-
+  if (auto f = driver::run_fit(run, print)) return fail(*f);
+  const ir::Model& model = run.compiled.integrated;
+  const FitSummary& summary = run.summary;
   if (!out_dir.empty()) {
-    auto written = write_fit_files(out_dir, {*compiled, compiled_path, summary, *options, records, validation, residuals,
-                                             choice ? &*choice : nullptr, refinement ? &*refinement : nullptr, iv ? &*iv : nullptr});
+    auto written = write_fit_files(out_dir, {run.compiled, compiled_path, summary, run.options, run.loaded.records, run.validation, run.residuals,
+                                             run.form_choice ? &*run.form_choice : nullptr, run.refinement ? &*run.refinement : nullptr,
+                                             run.instrumental_variables ? &*run.instrumental_variables : nullptr});
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
     if (paths.size() == 3) std::cerr << "wrote " << paths[0] << ", " << paths[1] << " and " << paths[2] << "\n";
@@ -220,9 +102,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   }
   if (!a.plots.empty() || !a.report.empty()) {
     static const std::vector<ValidationSummary> none;
-    const PictureContext context{*compiled, compiled_path, summary, *options, records, loaded->sources,
-                                 validation ? validation->runs : none, validation ? validation->note : std::string("was switched off (--no-validate)"),
-                                 residuals};
+    const PictureContext context{run.compiled, compiled_path, summary, run.options, run.loaded.records, run.loaded.sources,
+                                 run.validation ? run.validation->runs : none,
+                                 run.validation ? run.validation->note : std::string("was switched off (--no-validate)"), run.residuals};
     std::vector<std::string> written;
     if (!write_fit_pictures(context, {a.plots, a.report}, written, error)) return fail(error, exit_code::user_error);
     if (!a.plots.empty()) std::cerr << fmt::format("wrote {} pictures into {}\n", written.size() - (a.report.empty() ? 0 : 1), a.plots);

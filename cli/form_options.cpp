@@ -1,9 +1,6 @@
 #include "cli/form_options.hpp"
 
-#include <charconv>
-
-#include "diagnostics/model_catalogue.hpp"
-#include "ir/settings.hpp"
+#include "driver/record_settings.hpp"
 
 namespace sidc {
 
@@ -15,25 +12,12 @@ void add_form_options(CLI::App* cmd, FormArguments& a) {
 }
 
 std::optional<ir::IntegrationRequest> integration_request(const FormArguments& a, std::string& error) {
-  if (!a.form.empty()) {  // the same request as --integrate, named by its form
-    ir::IntegrationRequest r;
-    request_form(r, a.form);
-    return r;
-  }
-  if (a.integrate.empty()) return std::nullopt;
-  ir::IntegrationRequest r;
-  if (a.integrate == "auto") {
-    r.count = ir::IntegrationRequest::Count::automatic;
-    return r;
-  }
-  int n = -1;
-  const auto [end, ec] = std::from_chars(a.integrate.data(), a.integrate.data() + a.integrate.size(), n);
-  if (ec != std::errc() || end != a.integrate.data() + a.integrate.size() || n < 0 || n > 8) {
-    error = render(diag::integrate_option_invalid(a.integrate));
+  auto request = driver::integration_request(a.integrate, a.form);
+  if (auto* d = std::get_if<Diagnostic>(&request)) {
+    error = render(*d);
     return std::nullopt;
   }
-  r.times = n;
-  return r;
+  return std::get<std::optional<ir::IntegrationRequest>>(request);
 }
 
 }  // namespace sidc

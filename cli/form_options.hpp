@@ -2,9 +2,9 @@
 // `sidc fit`: the same request as the model's `set integrate`/`set form` (docs/language.md),
 // overriding every equation's.
 //
-// Relies on: ir/settings.hpp (request_form, the one reading of a form's name). Guarantees: the two
-// options exclude each other and read the same way in both commands; a bad `--integrate` value is
-// a rendered usage error, never an exception.
+// Relies on: driver/record_settings.hpp (integration_request, shared with the Python module).
+// Guarantees: the two options exclude each other and read the same way in both commands; a bad
+// `--integrate` value is a rendered usage error, never an exception.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -327,7 +327,7 @@ std::string fit_json_text(const FitHandle& s) {
 // groups share no parameter, and each is solved alone.
 py::tuple covariance(const FitHandle& s) {
   std::vector<std::string> names;
-  for (const auto& g : s->summary.groups)
+  for (const auto& g : s->run.summary.groups)
     for (const auto& p : g.summary.parameters) names.push_back(p.name);
   const auto n = static_cast<py::ssize_t>(names.size());
   py::array_t<double> out({n, n});
@@ -335,7 +335,7 @@ py::tuple covariance(const FitHandle& s) {
   for (py::ssize_t i = 0; i < n; ++i)
     for (py::ssize_t j = 0; j < n; ++j) m(i, j) = 0.0;
   py::ssize_t at = 0;
-  for (const auto& g : s->summary.groups) {
+  for (const auto& g : s->run.summary.groups) {
     const auto& c = g.summary.covariance;
     for (Eigen::Index i = 0; i < c.rows(); ++i)
       for (Eigen::Index j = 0; j < c.cols(); ++j) m(at + i, at + j) = c(i, j);
@@ -479,7 +479,7 @@ PYBIND11_MODULE(_sidc, module) {
       .def("json", &fit_json_text)
       .def("report", [](const FitHandle& s) { return s->report; })
       .def_property_readonly("warnings", [](const FitHandle& s) { return s->warnings; })
-      .def_property_readonly("usable", [](const FitHandle& s) { return s->summary.is_solution_usable(); })
+      .def_property_readonly("usable", [](const FitHandle& s) { return s->run.summary.is_solution_usable(); })
       .def("covariance", &covariance)
       .def("residuals", &residuals);
   module.def("compile_text", &compile_text, py::arg("text"), py::arg("name"));

@@ -1,11 +1,11 @@
-// What the Python module's `fit`, `select` and `simulate` do, in plain C++ (no Python here): the
-// same sequence of library calls as `sidc fit`, `sidc select` and `sidc simulate` (cli/*_command.cpp),
-// with the records given as CSV paths or as records already in memory (numpy arrays, converted by
-// python/module.cpp), and results kept instead of printed.
+// What the Python module's `fit`, `select` and `simulate` do, in plain C++ (no Python here): fit and
+// select are driver/'s, the same as `sidc fit` and `sidc select` run, with the records given as CSV
+// paths or as records already in memory (numpy arrays, converted by python/module.cpp), and the
+// report kept instead of printed; simulate checks its names as `sidc simulate` does.
 //
-// Relies on: compiler/ (the model, its forms), runtime/ (records, fit, validation, refinement,
-// selection, simulation), report/ (the text report and fit.json, report/fit_files.hpp). The command
-// line's option names are the settings' field names (`--validate-samples` is `validate_samples`).
+// Relies on: driver/ (fit, select, the settings), runtime/ (simulation), report/ (fit.json,
+// select.json). The command line's option names are the settings' field names
+// (`--validate-samples` is `validate_samples`).
 // Guarantees: every problem the CLI reports comes back as its Diagnostics, with the same wording,
 // never as an exception or a crash; nothing is written to a file, stdout or stderr; nothing here
 // touches Python, so the module runs these with the interpreter lock released.
@@ -20,16 +20,10 @@
 #include <nlohmann/json.hpp>
 
 #include "diagnostics/diagnostic.hpp"
+#include "driver/fit_run.hpp"
+#include "driver/select_run.hpp"
 #include "ir/compiled_model.hpp"
-#include "runtime/records/records.hpp"
-#include "runtime/refine/refine.hpp"
-#include "runtime/select/select.hpp"
-#include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/simulate.hpp"
-#include "runtime/simulate/validate.hpp"
-#include "runtime/solve/fit.hpp"
-#include "runtime/solve/instrumental_variables.hpp"
-#include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc::python {
 
@@ -41,16 +35,10 @@ struct LoadedModel {
   std::string directory;  // for relative data paths
 };
 
-// One record: a CSV path (read as `--data` reads it) or a record already in memory.
-using RecordInput = std::variant<std::string, Record>;
+using driver::RecordInput;
+using driver::RecordSettings;
 
-// The options `sidc fit` and `sidc select` share (cli/record_options.hpp), by their option names.
-struct RecordSettings {
-  std::optional<double> from, to, step, resample;
-  std::optional<int> every;
-  std::string derivative, second_derivative, edges, integration, precision, weights;
-};
-
+// `sidc fit`'s options as keywords; `integrate` and `form` as given, read by the session.
 struct FitSettings {
   RecordSettings records;
   std::string integrate, form;  // --integrate N|auto, --form derivative|integrated|weak
@@ -62,28 +50,11 @@ struct FitSettings {
   std::string estimator;  // "", least_squares, iv
 };
 
-struct SelectSettings {
-  RecordSettings records;
-  std::string method = "automatic", rule = "elbow";
-  std::vector<std::string> required, dropped;
-  std::vector<std::pair<std::string, std::vector<std::string>>> groups;
-  int folds = 5, bootstrap = 0, max_size = -1;
-  std::uint64_t seed = 1;
-  bool simulate = false, keep_drift = false;
-  std::size_t simulate_samples = 100000;
-};
+using SelectSettings = driver::SelectSettings;
 
-// Everything one fit produced, kept for the result's properties.
+// Everything one fit produced (driver/fit_run.hpp), with what `sidc fit` would print.
 struct FitSession {
-  LoadedModel model;  // its `integrated` is the form fitted
-  FitOptions options;
-  std::vector<SampledRecord> records;
-  std::optional<FormChoice> form_choice;
-  FitSummary summary;
-  std::optional<InstrumentalVariablesSummary> instrumental_variables;
-  std::optional<RefineSummary> refinement;
-  std::optional<FitValidation> validation;
-  ResidualAnalysis residuals;
+  driver::FitRun run;
   std::string report;                  // what `sidc fit` prints on stdout
   std::vector<std::string> warnings;   // what it prints on stderr, rendered, one per entry
 };

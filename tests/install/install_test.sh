@@ -25,7 +25,7 @@ step() { echo "== $*"; }
 
 # What is installed is what the sources say now (a no-op when the build is up to date).
 step "building the installed targets in $build"
-"$cmake" --build "$build" --target sidc sidc_diagnostics sidc_ir sidc_grammar sidc_compiler sidc_runtime sidc_report \
+"$cmake" --build "$build" --target sidc sidc_diagnostics sidc_ir sidc_grammar sidc_compiler sidc_runtime sidc_report sidc_driver \
   > "$work/build.log" 2>&1 || { cat "$work/build.log"; fail "cannot build sidc in $build"; }
 
 step "cmake --install $build --prefix $prefix"
@@ -33,13 +33,13 @@ step "cmake --install $build --prefix $prefix"
 
 package=$(dirname "$(find "$prefix" -path '*/cmake/sidc/sidcConfig.cmake' -print -quit)")
 [[ $package != . ]] || fail "no sidcConfig.cmake installed under $prefix"
-for f in bin/sidc include/sidc/runtime/solve/fit.hpp include/sidc/compiler/pipeline.hpp include/sidc/diagnostics/diagnostic.hpp; do
+for f in bin/sidc include/sidc/runtime/solve/fit.hpp include/sidc/compiler/pipeline.hpp include/sidc/diagnostics/diagnostic.hpp include/sidc/driver/fit_run.hpp; do
   [[ -e $prefix/$f ]] || fail "$f not installed"
 done
 for f in sidcConfig.cmake sidcConfigVersion.cmake sidcTargets.cmake; do
   [[ -e $package/$f ]] || fail "$package/$f not installed"
 done
-for lib in diagnostics ir grammar compiler runtime report; do
+for lib in diagnostics ir grammar compiler runtime report driver; do
   [[ -n $(find "$prefix" -name "libsidc_$lib.*" -print -quit) ]] || fail "libsidc_$lib not installed"
 done
 # Only sidc's own build may see its warnings, -Werror, sanitizers and SIDC_VERSION; and an

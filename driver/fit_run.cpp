@@ -1,0 +1,164 @@
+#include "driver/fit_run.hpp"
+
+#include <fmt/format.h>
+
+#include "compiler/hold_check_pass.hpp"
+#include "compiler/integrate_pass.hpp"
+#include "compiler/pipeline.hpp"
+#include "compiler/weak_pass.hpp"
+#include "diagnostics/cli_catalogue.hpp"
+#include "ir/queries.hpp"
+#include "ir/settings.hpp"
+#include "report/text_reports.hpp"
+#include "runtime/solve/fitted_values.hpp"
+
+namespace sidc::driver {
+namespace {
+
+Failure failure(Diagnostic d, bool bad_setting = false) { return Failure{{std::move(d)}, bad_setting}; }
+
+// The model names no form: each is fitted, and the weak form, the most accurate on known-truth
+// records (docs/accuracy.md), is kept unless another's solved equations follow the record better
+// on every piece of it (form_choice.hpp). Without validation there is nothing to judge them by.
+std::string choose_the_form(FitRun& run) {
+  CompiledModel& compiled = run.compiled;
+  if (run.settings.no_validate) {
+    compiled.integrated = rewritten_in_form(compiled.normalized, "weak");
+    return "form: weak, the most accurate on known-truth records (docs/accuracy.md); the model sets none, and with\n" + run.settings.no_validate_name +
+           " there is no simulation to choose one by\n";
+  }
+  std::vector<ir::Model> rewritten;
+  std::vector<std::string> names;
+  Diagnostics held;
+  for (const std::string form : {"weak", "derivative", "integrated"}) {
+    ir::Model m = rewritten_in_form(compiled.normalized, form);
+    // A form that leaves a derivative of a held input (the derivative form of `x'`) is no candidate.
+    if (!hold_check_pass(m, held)) continue;
+    rewritten.push_back(std::move(m));
+    names.push_back(form);
+  }
+  std::vector<FormCandidate> candidates;
+  for (std::size_t i = 0; i < names.size(); ++i) candidates.push_back({names[i], &rewritten[i]});
+  run.form_choice =
+      choose_form(candidates, compiled.normalized, *compiled.explicit_form, run.loaded.records, run.options, run.settings.validate_samples);
+  compiled.integrated = std::move(rewritten[run.form_choice->chosen]);
+  return run.form_choice->report();
+}
+
+}  // namespace
+
+std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compiled, std::string model_path, const std::string& directory,
+                                                           std::vector<RecordInput> inputs, FitSettings settings, const FitOutput& out) {
+  auto run = std::make_unique<FitRun>();
+  run->compiled = std::move(compiled);
+  run->model_path = std::move(model_path);
+  run->settings = std::move(settings);
+  CompiledModel& c = run->compiled;
+  if (run->settings.form) {
+    // Every equation rewritten as `sidc compile` with the same option would.
+    IntegrateOptions rewrite;
+    rewrite.override_request = run->settings.form;
+    Diagnostics problems;
+    ir::Model m = weak_pass(integrate_pass(c.normalized, rewrite, problems), problems);
+    hold_check_pass(m, problems);
+    if (problems.has_errors()) return Failure{problems.items};
+    for (const auto& p : problems.items) out.warning(render(p));
+    m.form_from_data = false;
+    c.integrated = std::move(m);
+  }
+  auto options = fit_options(c.integrated, run->settings.records);
+  if (auto* d = std::get_if<Diagnostic>(&options)) return failure(*d, true);
+  run->options = std::get<FitOptions>(options);
+  auto loaded = load_records(c, directory, std::move(inputs), run->settings.records);
+  if (auto* d = std::get_if<Diagnostic>(&loaded)) return failure(*d);
+  run->loaded = std::get<LoadedRecords>(std::move(loaded));
+  return run;
+}
+
+std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
+  CompiledModel& compiled = run.compiled;
+  const FitSettings& a = run.settings;
+  const FitOptions& o = run.options;
+  const std::vector<SampledRecord>& records = run.loaded.records;
+  const std::string form_report = compiled.integrated.form_from_data ? choose_the_form(run) : "";
+  const ir::Model& model = compiled.integrated;
+
+  auto result = fit(model, records, o);
+  if (auto* d = std::get_if<Diagnostic>(&result)) return failure(*d);
+  run.summary = std::get<FitSummary>(std::move(result));
+  const FitSummary& summary = run.summary;
+  for (const auto& r : summary.operators)
+    for (const auto& w : r.warnings) out.warning(render(w));
+  for (const auto& g : summary.groups)
+    for (const auto& w : drift_warnings(model, g.drift)) out.warning(render(w));
+  for (const auto& w : statistics_warnings(model, summary)) out.warning(render(w));
+  std::string report = fmt::format("sidc fit: model `{}` ({})\n\n", model.name, run.model_path) + form_report + (form_report.empty() ? "" : "\n") +
+                       operator_report(summary.operators, o.evaluation, model);
+  if (!is_static(model)) report += "\n";
+  out.report(report + summary.full_report(model));
+
+  // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;
+  // validation solves with its estimate (or the refined one); residual tests and pictures stay
+  // those of the equation-error fit.
+  auto& iv = run.instrumental_variables;
+  if (a.estimator.empty() ? estimator_setting(model.settings) == Estimator::instrumental_variables : a.estimator == "iv") {
+    iv = instrumental_variables(model, compiled.normalized, *compiled.explicit_form, records, o, summary);
+    out.report("\n" + iv->full_report());
+    if (!iv->is_solution_usable()) out.warning(render(cli_diag::instrumental_variables_not_converged(iv->statement)));
+  }
+  // The estimate the fit stands by, in the derivative form's parameters: the IV one when it was
+  // asked for and usable, else the equation-error one. Refinement starts from it.
+  const std::vector<double> fitted_estimate =
+      iv && iv->is_solution_usable() ? instrumental_parameter_values(compiled.normalized, *iv, fitted_parameter_values(compiled.normalized, summary, 0.0))
+                                     : fitted_parameter_values(compiled.normalized, summary, 0.0);
+
+  // Output-error refinement (issue 15): from that estimate, the parameters whose solved equations
+  // reproduce the fitted records best. A failure keeps the estimate it started from and says so.
+  auto& refinement = run.refinement;
+  if ((a.refine || refine_by_simulation(compiled.normalized.settings)) && summary.is_solution_usable()) {
+    if (auto* d = std::get_if<Diagnostic>(&*compiled.explicit_form)) {
+      refinement.emplace();
+      refinement->message = "the equations cannot be solved for their highest derivatives (" + d->message + "); the equation-error estimate is kept";
+    } else {
+      RefineOptions ro;
+      ro.evaluation = o.evaluation;
+      ro.max_samples = a.validate_samples;
+      ro.from = o.from;
+      ro.to = o.to;
+      std::vector<const SampledRecord*> fitted;
+      for (const auto& r : records) fitted.push_back(&r);
+      auto refined = refine(compiled.normalized, std::get<ExplicitForm>(*compiled.explicit_form), fitted_estimate, fitted, ro);
+      if (auto* problem = std::get_if<Diagnostic>(&refined)) return failure(*problem);
+      refinement = std::get<RefineSummary>(std::move(refined));
+    }
+    out.report("\n" + refinement->report());
+    if (!refinement->improved()) out.warning("sidc fit: warning: not refined: " + refinement->message);
+  }
+
+  if (!a.no_validate) {
+    // The fitted records, then those given only to be compared with (not copied: records can be long).
+    std::vector<SampledRecord> extra;
+    for (auto& input : run.settings.validate) {
+      auto record = load_record(model, std::move(input), run.loaded.bind);
+      if (auto* d = std::get_if<Diagnostic>(&record)) return failure(*d);
+      extra.push_back(std::get<SampledRecord>(std::move(record)));
+    }
+    run.settings.validate.clear();
+    std::vector<const SampledRecord*> checked;
+    for (const auto& r : records) checked.push_back(&r);
+    for (const auto& r : extra) checked.push_back(&r);
+    run.validation = validate_fit(compiled.normalized, *compiled.explicit_form, summary, checked, records.size(), o.evaluation, a.validate_samples,
+                                  a.initial_state,
+                                  refinement && refinement->improved() ? &refinement->values
+                                  : iv && iv->is_solution_usable()      ? &fitted_estimate
+                                                                        : nullptr,
+                                  refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables");
+    if (run.validation->failed_record) return failure(cli_diag::cannot_validate(run.validation->failed_path, *run.validation->failed_record));
+    out.report(validation_report(*run.validation, records.size()));
+  }
+  run.residuals = analyse_residuals(model, summary, records, o);
+  out.report(residual_report(run.residuals));
+  return std::nullopt;
+}
+
+}  // namespace sidc::driver

@@ -1,0 +1,77 @@
+// `sidc fit`'s work without its command line, for every face that fits (cli/fit_command.cpp, the
+// Python module): the model in the requested form, its records, the form chosen from the data when
+// the model names none, the equation-error fit, the instrumental variables and the output-error
+// refinement when asked for, the validation (thesis section 2-4) and the residual analysis.
+//
+// Two steps, so that a face can look at what will be read before any work (the command line refuses
+// an output that would overwrite an input): prepare_fit, then run_fit. The text of the report goes
+// out section by section as it is known, through FitOutput, which the command line prints at once
+// and the Python module keeps.
+//
+// Relies on: compiler/ (the rewrites), runtime/ (everything computed), report/text_reports.hpp
+// (the tables printed after the fit's own report). Guarantees: every problem is a Failure holding
+// the Diagnostics the command line prints, never an exception; nothing is written to a file, and
+// nothing to stdout or stderr except through FitOutput.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "driver/failure.hpp"
+#include "driver/record_settings.hpp"
+#include "runtime/refine/refine.hpp"
+#include "runtime/simulate/form_choice.hpp"
+#include "runtime/simulate/validate.hpp"
+#include "runtime/solve/instrumental_variables.hpp"
+#include "runtime/solve/residual_analysis.hpp"
+
+namespace sidc::driver {
+
+// `sidc fit`'s options beyond the records' (docs/cli.md), by their names there.
+struct FitSettings {
+  RecordSettings records;
+  std::optional<ir::IntegrationRequest> form;  // --integrate/--form: every equation rewritten so
+  bool no_validate = false;
+  std::vector<RecordInput> validate;          // records only compared with, not fitted
+  std::size_t validate_samples = 100000;      // compared at most per record (0 = all)
+  InitialState initial_state = InitialState::estimate;
+  bool refine = false;
+  std::string estimator;                      // "", least_squares or iv: over the model's `set estimator`
+  std::string no_validate_name = "--no-validate";  // how the face names that option in the report
+};
+
+// Where the text goes as it is known: `report` takes what `sidc fit` prints on stdout, `warning` one
+// rendered line of what it prints on stderr (without the line's end).
+struct FitOutput {
+  std::function<void(const std::string&)> report, warning;
+};
+
+// One fit, from its model and records to everything it produced.
+struct FitRun {
+  CompiledModel compiled;  // `integrated` is the form fitted (after run_fit: chosen, when the model names none)
+  std::string model_path;  // as named in the report
+  FitSettings settings;
+  FitOptions options;
+  LoadedRecords loaded;
+  std::optional<FormChoice> form_choice;
+  FitSummary summary;
+  std::optional<InstrumentalVariablesSummary> instrumental_variables;
+  std::optional<RefineSummary> refinement;
+  std::optional<FitValidation> validation;
+  ResidualAnalysis residuals;
+};
+
+// The model rewritten as `settings.form` asks (its warnings sent to `out`), the fit's options and
+// the records (`inputs`, or with none the model's data statements taken from `directory`).
+std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compiled, std::string model_path, const std::string& directory,
+                                                           std::vector<RecordInput> inputs, FitSettings settings, const FitOutput& out);
+
+// Everything else, the report sent to `out` section by section. A rank-deficient fit is no
+// failure here: `run.summary.is_solution_usable()` tells, and each face says it its own way.
+std::optional<Failure> run_fit(FitRun& run, const FitOutput& out);
+
+}  // namespace sidc::driver

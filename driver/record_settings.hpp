@@ -1,0 +1,60 @@
+// What every fit and selection shares, whichever face asks (the command line, the Python module):
+// the settings that say how to evaluate the model on its records (the model's own `set` statements,
+// overridden one by one), the form requested over the model's, and the records themselves, read
+// from CSV or handed over in memory, bound as the model's first data statement binds them.
+//
+// Relies on: ir/settings.hpp (the settings), runtime/solve/options_from_settings.hpp (the one
+// translation of settings into runtime options), runtime/records/ (reading and binding).
+// Guarantees: every problem comes back as the Diagnostic the command line prints, never an
+// exception; a record given in memory is moved, never copied.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "diagnostics/diagnostic.hpp"
+#include "ir/compiled_model.hpp"
+#include "ir/settings.hpp"
+#include "runtime/records/bind_record.hpp"
+#include "runtime/records/records.hpp"
+#include "runtime/solve/fit.hpp"
+
+namespace sidc::driver {
+
+// The overrides of the model's evaluation settings, named as `sidc fit` names its options
+// (`--second-derivative` is `second_derivative`); empty or unset: the model's own.
+struct RecordSettings {
+  std::optional<double> from, to, step, resample;
+  std::optional<int> every;
+  std::string derivative, second_derivative, edges, integration, precision, weights;
+};
+
+// The model's settings overridden; a moving arc that cannot be read is the error.
+std::variant<EvaluationSettings, Diagnostic> evaluation_settings(const ir::Model& model, const RecordSettings& settings);
+// The same, translated into the fit's options, with the arithmetic (`precision`) and checked.
+std::variant<FitOptions, Diagnostic> fit_options(const ir::Model& model, const RecordSettings& settings);
+
+// The rewrite `--integrate N|auto` or `--form NAME` asks for (docs/language.md: `set integrate`,
+// `set form`): nullopt when both are empty; an error when `integrate` is not 0-8 or `auto`.
+std::variant<std::optional<ir::IntegrationRequest>, Diagnostic> integration_request(const std::string& integrate, const std::string& form);
+
+// One record: a CSV path (read as `--data` reads it) or a record already in memory.
+using RecordInput = std::variant<std::string, Record>;
+
+struct LoadedRecords {
+  std::vector<ir::DataSource> sources;  // paths resolved
+  std::vector<SampledRecord> records;
+  BindOptions bind;                     // as used, for further records (`--validate`)
+};
+
+// The records `inputs` name, each bound as the model's first data statement; with none, the
+// model's own data statements, relative paths taken from `directory` (the model file's folder).
+std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compiled, const std::string& directory, std::vector<RecordInput> inputs,
+                                                     const RecordSettings& settings);
+
+// One more record, bound like the others as the model's first data statement.
+std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind);
+
+}  // namespace sidc::driver

@@ -9,11 +9,14 @@
 //   code as fields); a wrong keyword or a wrong type raises TypeError, a wrong value ValueError, with
 //   the catalogue's wording.
 // - A dict of 1-D arrays is the record a CSV with those column names would give (`t` or `time` is
-//   the time column, as read_csv and bind_record take it). A float64 array is read straight from its
-//   buffer into the record, once (a contiguous one by one memcpy, no conversion); the record's
-//   columns are then moved, never copied, into the bound record. Other float dtypes are converted
-//   first; integer, bool, complex and object arrays are refused. A "row" in a message about an
-//   array is its 0-based index, the "column" the 1-based position of its key.
+//   the time column, as read_csv and bind_record take it). A contiguous, aligned float64 array is
+//   not copied: the record borrows its memory (runtime/records/column.hpp) and holds a reference to
+//   the array for as long as the fit keeps the record (the result's residuals() read it again), so
+//   the array must not be changed meanwhile. A strided one is copied once; other float dtypes are
+//   converted by numpy first (and the converted array borrowed); integer, bool, complex and object
+//   arrays are refused. Binding, the fit window and the operators read the borrowed memory in
+//   place; only `every`, `resample` or a held input's shift make new columns. A "row" in a message
+//   about an array is its 0-based index, the "column" the 1-based position of its key.
 // - Arrays handed back (residuals, simulated outputs) are the result's own memory, wrapped without
 //   a copy.
 // - The interpreter lock is released while sidc computes (the fit, its residuals, a selection, a
@@ -23,6 +26,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
@@ -85,23 +89,32 @@ std::string type_name(const py::handle& h) { return py::str(py::type::of(h).attr
 
 // ---- records ---------------------------------------------------------------------------------
 
-// One column from an array: float64 read from its buffer as it lies (strided or not), other float
-// dtypes converted by numpy first.
-std::vector<double> column_values(const std::string& record, const std::string& name, const py::handle& value) {
+// What keeps an array's memory alive while a column borrows it: a reference to the array, given
+// back under the interpreter lock (the last column may go while sidc computes without it).
+std::shared_ptr<const void> reference_to(py::array array) {
+  return std::shared_ptr<const void>(new py::object(std::move(array)), [](const void* held) {
+    py::gil_scoped_acquire lock;
+    delete static_cast<const py::object*>(held);
+  });
+}
+
+// One column from an array: a contiguous float64 array borrowed where it lies (no copy), a
+// strided one copied element by element, other float dtypes converted by numpy first (and the
+// converted array borrowed).
+Column column_values(const std::string& record, const std::string& name, const py::handle& value) {
   py::array array = py::isinstance<py::array>(value) ? py::reinterpret_borrow<py::array>(value) : py::array(py::module_::import("numpy").attr("asarray")(value));
   if (array.ndim() != 1) value_error(cli_diag::array_not_one_dimensional(record, name, static_cast<std::size_t>(array.ndim())));
   const char kind = array.dtype().kind();
   if (kind != 'f') type_error(cli_diag::array_not_float(record, name, py::str(array.dtype()).cast<std::string>()));
   if (!array.dtype().is(py::dtype::of<double>())) array = py::array_t<double, py::array::forcecast>::ensure(array);
   const auto n = static_cast<std::size_t>(array.shape(0));
-  std::vector<double> out(n);
   const auto stride = array.strides(0);
   const char* base = static_cast<const char*>(array.data());
-  if (stride == static_cast<py::ssize_t>(sizeof(double))) {
-    if (n) std::memcpy(out.data(), base, n * sizeof(double));
-  } else {
-    for (std::size_t i = 0; i < n; ++i) std::memcpy(&out[i], base + static_cast<py::ssize_t>(i) * stride, sizeof(double));
-  }
+  const bool aligned = reinterpret_cast<std::uintptr_t>(base) % alignof(double) == 0;
+  if (aligned && (stride == static_cast<py::ssize_t>(sizeof(double)) || n < 2))
+    return Column::borrowed({reinterpret_cast<const double*>(base), n}, reference_to(std::move(array)));
+  std::vector<double> out(n);
+  for (std::size_t i = 0; i < n; ++i) std::memcpy(&out[i], base + static_cast<py::ssize_t>(i) * stride, sizeof(double));
   return out;
 }
 
@@ -399,7 +412,7 @@ py::tuple run_select(const ModelHandle& m, const py::object& data, const py::dic
   return py::make_tuple(r.document.dump(), r.report, r.warnings);
 }
 
-std::vector<double> values_of(const std::string& what, const py::handle& value) { return column_values("simulate", what, value); }
+std::vector<double> values_of(const std::string& what, const py::handle& value) { return column_values("simulate", what, value).to_vector(); }
 
 py::tuple run_simulate(const ModelHandle& m, const py::dict& params, const py::object& inputs, const py::object& t, const py::object& initial,
                        const py::dict& kwargs) {

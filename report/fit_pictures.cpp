@@ -92,9 +92,9 @@ std::optional<std::vector<double>> exact_column(const Record& r, const ir::DataS
   std::string time_name = "t";
   for (const auto& [signal, col] : source.bindings)
     if (signal == "t") time_name = col;
-  const std::vector<double>* time = r.column(time_name);
+  const Column* time = r.column(time_name);
   if (!time && time_name == "t") time = r.column("time");
-  const std::vector<double>* values = r.column(column);
+  const Column* values = r.column(column);
   if (!time || !values || time->size() < 2) return std::nullopt;
   const double t0 = time->front(), step = ((*time)[time->size() - 1] - t0) / static_cast<double>(time->size() - 1);
   if (!(step > 0) || !std::isfinite(step)) return std::nullopt;  // no uniform time column to match by

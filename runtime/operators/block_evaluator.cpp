@@ -155,7 +155,7 @@ std::variant<const BlockEvaluator::Values*, Diagnostic> BlockEvaluator::factor(c
 std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(const ir::Factor& f, const Span& where, Range r) {
   const std::size_t n = r.size();
   const std::size_t samples = record_.time.size();
-  const auto slice = [&](const std::vector<double>& whole, Range from) {
+  const auto slice = [&](std::span<const double> whole, Range from) {
     return Values(whole.begin() + static_cast<std::ptrdiff_t>(from.first), whole.begin() + static_cast<std::ptrdiff_t>(from.last));
   };
   // The range widened by `m` samples each side, within the record: what a derivative operator

@@ -20,7 +20,7 @@ using ir::FactorKind;
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-std::size_t index_at_or_after(const std::vector<double>& time, double t) {
+std::size_t index_at_or_after(std::span<const double> time, double t) {
   const double tolerance = 1e-9 * std::max(1.0, std::abs(t));
   return static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), t - tolerance) - time.begin());
 }
@@ -150,7 +150,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::strin
   if (found == record_.signals.end()) {
     return diag::signal_not_in_record(where, name, record_.path);
   }
-  if (order == 0) return derivatives_[key] = found->second;
+  if (order == 0) return derivatives_[key] = Values(found->second.begin(), found->second.end());
   auto estimate = derivative_operator(options_, order, name)->apply(found->second, record_.step);
   if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
   return derivatives_[key] = std::get<Values>(std::move(estimate));
@@ -189,7 +189,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
   const std::size_t n = record_.time.size();
   switch (f.kind) {
     case FactorKind::signal: return signal(f.name, f.order, where);
-    case FactorKind::time: return record_.time;
+    case FactorKind::time: return Values(record_.time.begin(), record_.time.end());
     case FactorKind::elapsed: {
       Values v(n);
       const double t0 = record_.time[window_.first];

@@ -39,13 +39,14 @@ SampledRecord piece_record(const SampledRecord& record, const ir::Model& model, 
   for (auto& [name, values] : out.signals) {
     const ir::Signal* input = piecewise_input(model, name);
     if (!input) continue;
-    const std::vector<double>& x = record.signals.at(name);
+    const Column& x = record.signals.at(name);
+    std::vector<double>& shifted = values.owned();
     const auto n = static_cast<std::ptrdiff_t>(x.size());
     if (n == 0) continue;
     auto at = [&](std::ptrdiff_t k) { return x[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(k, 0, n - 1))]; };
     for (std::ptrdiff_t k = 0; k < n; ++k) {
       const std::ptrdiff_t i = k - d;  // the interval whose piece sample k is read from
-      values[static_cast<std::size_t>(k)] = input->hold == ir::Signal::Hold::held ? at(i) : at(i) + d * (at(i + 1) - at(i));
+      shifted[static_cast<std::size_t>(k)] = input->hold == ir::Signal::Hold::held ? at(i) : at(i) + d * (at(i + 1) - at(i));
     }
   }
   return out;

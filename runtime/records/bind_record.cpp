@@ -27,8 +27,8 @@ bool bound(const ir::DataSource& source, const std::string& signal) {
 std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned, const ir::DataSource& source,
                                              const ir::Model& model, const BindOptions& options) {
   // How often each column is taken, so that only its last use may move it.
-  std::map<const std::vector<double>*, int> uses;
-  const auto take = [&](const std::vector<double>* column) {
+  std::map<const Column*, int> uses;
+  const auto take = [&](const Column* column) -> Column {
     if (owned && --uses[column] == 0) {
       const auto index = static_cast<std::size_t>(column - record.columns.data());
       return std::move(owned->columns[index]);
@@ -51,7 +51,7 @@ std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned
   for (const auto& s : model.signals)
     if (!s.definition) count_use(column_for(source, s.name));
   if (options.weights) count_use(*options.weights);
-  std::vector<double> time;
+  Column time;
   if (!time_column.empty()) {
     auto column = complete_column(record, time_column);
     if (auto* d = std::get_if<Diagnostic>(&column)) return *d;
@@ -60,33 +60,34 @@ std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned
       if (auto* d = std::get_if<Diagnostic>(&step)) return *d;
       out.step = std::get<double>(step);
     }
-    time = take(std::get<const std::vector<double>*>(column));
+    time = take(std::get<const Column*>(column));
   } else if (options.step || is_static(model)) {
     // A static model's rows are observations, not samples in time: number them 0, 1, 2, ...
     out.step = options.step.value_or(1.0);
-    time.resize(rows);
-    for (std::size_t k = 0; k < rows; ++k) time[k] = static_cast<double>(k) * out.step;
+    auto& grid = time.owned();
+    grid.resize(rows);
+    for (std::size_t k = 0; k < rows; ++k) grid[k] = static_cast<double>(k) * out.step;
   } else {
     return data_diag::no_time_column(record.path, record.header_line > 0 ? record.header_line : 1);
   }
 
   // The signals read from columns.
   std::vector<std::string> names;
-  std::vector<std::vector<double>> columns;
+  std::vector<Column> columns;
   for (const auto& s : model.signals) {
     if (s.definition) continue;
     const std::string column = column_for(source, s.name);
     auto values = complete_column(record, column);
     if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
     names.push_back(s.name);
-    columns.push_back(take(std::get<const std::vector<double>*>(values)));
+    columns.push_back(take(std::get<const Column*>(values)));
     out.columns[s.name] = column;
   }
 
   if (options.weights) {
     auto values = complete_column(record, *options.weights);
     if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    columns.push_back(take(std::get<const std::vector<double>*>(values)));  // resampled and decimated with the signals
+    columns.push_back(take(std::get<const Column*>(values)));  // resampled and decimated with the signals
     out.weights_column = *options.weights;
   }
 
@@ -101,17 +102,17 @@ std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned
     }
     ResampledSignals r = resample_linear(time, columns, *options.resample);
     time = std::move(r.time);
-    columns = std::move(r.columns);
+    columns.assign(std::make_move_iterator(r.columns.begin()), std::make_move_iterator(r.columns.end()));
     out.step = *options.resample;
   }
 
   const std::size_t every = static_cast<std::size_t>(std::max(1, options.every));
   // Every sample kept: the columns as they are, not copied again.
-  const auto kept = [&](std::vector<double>& values) { return every == 1 ? std::move(values) : decimate(values, every); };
+  const auto kept = [&](Column& values) { return every == 1 ? std::move(values) : Column(decimate(values, every)); };
   out.time = kept(time);
   out.step *= static_cast<double>(every);
   for (std::size_t i = 0; i < names.size(); ++i) out.signals[names[i]] = kept(columns[i]);
-  if (options.weights) out.weights = kept(columns.back());  // the one column past the signals
+  if (options.weights) out.weights = kept(columns.back()).release();  // the one column past the signals
 
   // Inputs given as expressions of t (the thesis' x = 60 sin 4 pi t), evaluated on the grid.
   for (const auto& s : model.signals) {

@@ -581,7 +581,7 @@ std::optional<std::size_t> Record::column_index(std::string_view name) const {
   return std::nullopt;
 }
 
-const std::vector<double>* Record::column(std::string_view name) const {
+const Column* Record::column(std::string_view name) const {
   const auto k = column_index(name);
   return k ? &columns[*k] : nullptr;
 }
@@ -645,7 +645,7 @@ std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOpti
   return parse_csv(std::string_view(bytes.data.get(), bytes.size), path, options);
 }
 
-std::variant<const std::vector<double>*, Diagnostic> complete_column(const Record& record, std::string_view name) {
+std::variant<const Column*, Diagnostic> complete_column(const Record& record, std::string_view name) {
   const auto k = record.column_index(name);
   if (!k) return data_diag::unknown_column(record.path, record.header_line, name, record.names);
   const auto& values = record.columns[*k];

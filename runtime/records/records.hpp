@@ -38,6 +38,7 @@
 
 #include "diagnostics/diagnostic.hpp"
 #include "diagnostics/data_catalogue.hpp"
+#include "runtime/records/column.hpp"
 
 namespace sidc {
 
@@ -53,7 +54,7 @@ struct FaultyCell {
 struct Record {
   std::string path;                           // as given; shown in diagnostics
   std::vector<std::string> names;             // one per column
-  std::vector<std::vector<double>> columns;   // column-major, all of length rows()
+  std::vector<Column> columns;                // column-major, all of length rows() (owned, or borrowed: column.hpp)
   std::vector<std::vector<FaultyCell>> first_faults;  // per column: the first few faulty cells, with text
   int header_line = 0;                        // 1-based line of the header; 0 when there is none
 
@@ -67,7 +68,7 @@ struct Record {
 
   std::size_t rows() const { return columns.empty() ? 0 : columns.front().size(); }
   std::optional<std::size_t> column_index(std::string_view name) const;
-  const std::vector<double>* column(std::string_view name) const;  // null when there is no such column
+  const Column* column(std::string_view name) const;  // null when there is no such column
   bool is_resampled() const { return !interpolated_from.empty(); }
   // Row r of this record is row original_row(r) of the record as read: origin_first + r *
   // origin_stride, looked up in interpolated_from after resampling.
@@ -98,7 +99,7 @@ std::variant<Record, Diagnostic> parse_csv(std::string_view text, const std::str
 
 // The column `name` when every cell of it holds a finite number; otherwise the diagnostic for its
 // first faulty cell, or for a name that is not in the header (with a did-you-mean hint).
-std::variant<const std::vector<double>*, Diagnostic> complete_column(const Record& record, std::string_view name);
+std::variant<const Column*, Diagnostic> complete_column(const Record& record, std::string_view name);
 
 // The fault a stored value carries (CellFault::none for every ordinary number).
 CellFault cell_fault(double value);

@@ -7,14 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "runtime/records/column.hpp"
+
 namespace sidc {
 
 // One record's signals on one uniform time grid.
 struct SampledRecord {
   std::string path;                                    // for messages
   double step = 0;
-  std::vector<double> time;                            // absolute times, time[k] = time[0] + k*step
-  std::map<std::string, std::vector<double>> signals;  // by signal name
+  Column time;                                         // absolute times, time[k] = time[0] + k*step
+  std::map<std::string, Column> signals;               // by signal name (columns.hpp: owned or borrowed)
   std::map<std::string, std::string> columns;          // signal -> the column it came from (for messages)
   std::vector<double> weights;                         // eq. 2-1.6: per sample; empty = all 1
   std::string weights_column;

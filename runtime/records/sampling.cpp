@@ -64,7 +64,7 @@ std::variant<double, Diagnostic> uniform_step(const Record& record, std::string_
                                               const UniformStepOptions& options) {
   auto column = complete_column(record, time_column);
   if (auto* d = std::get_if<Diagnostic>(&column)) return std::move(*d);
-  const auto& time = *std::get<const std::vector<double>*>(column);
+  const auto& time = *std::get<const Column*>(column);
   const StepCheck check = check_uniform_step(time, options);
   const int field = record.field_of_column(*record.column_index(time_column));
   const std::size_t i = check.bad_index;
@@ -100,7 +100,7 @@ std::variant<IndexRange, Diagnostic> time_window(const Record& record, std::stri
                                                  double to) {
   auto column = complete_column(record, time_column);
   if (auto* d = std::get_if<Diagnostic>(&column)) return std::move(*d);
-  const auto& time = *std::get<const std::vector<double>*>(column);
+  const auto& time = *std::get<const Column*>(column);
   const IndexRange rows = time_window(time, from, to);
   if (rows.empty()) return data_diag::empty_time_window(record.path, time_column, from, to, time.front(), time.back());
   return rows;
@@ -151,7 +151,7 @@ std::size_t max_resampled_rows(std::size_t rows) {
   return rows > kResampledRowsFloor / kResampledRowsPerRow ? rows * kResampledRowsPerRow : kResampledRowsFloor;
 }
 
-ResampledSignals resample_linear(std::span<const double> time, const std::vector<std::vector<double>>& columns,
+ResampledSignals resample_linear(std::span<const double> time, const std::vector<Column>& columns,
                                  double step) {
   ResampledSignals out;
   if (time.size() < 2 || !(step > 0) || !std::isfinite(step)) return out;
@@ -192,7 +192,7 @@ ResampledSignals resample_linear(std::span<const double> time, const std::vector
 std::variant<Record, Diagnostic> resample_linear(const Record& record, std::string_view time_column, double step) {
   auto column = complete_column(record, time_column);
   if (auto* d = std::get_if<Diagnostic>(&column)) return std::move(*d);
-  const auto& time = *std::get<const std::vector<double>*>(column);
+  const auto& time = *std::get<const Column*>(column);
   // Resampling cures a non-uniform step, but not a time that stands still or goes backwards.
   UniformStepOptions any_spacing;
   any_spacing.relative_tolerance = 0.49;
@@ -209,7 +209,7 @@ std::variant<Record, Diagnostic> resample_linear(const Record& record, std::stri
   Record out = same_file_as(record);
   // The time column is the grid itself, not an interpolation of it.
   signals.columns[*record.column_index(time_column)] = signals.time;
-  out.columns = std::move(signals.columns);
+  out.columns.assign(std::make_move_iterator(signals.columns.begin()), std::make_move_iterator(signals.columns.end()));
   // Each new row remembers the earlier of the two rows it lies between (or the row it falls on).
   out.interpolated_from.resize(signals.time.size());
   std::size_t i = 0;

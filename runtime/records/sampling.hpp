@@ -85,7 +85,7 @@ std::size_t max_resampled_rows(std::size_t rows);
 // Linear interpolation of `columns` (each of time.size()) onto a uniform grid starting at
 // time[0]. Requires strictly increasing, finite time, step > 0 and at most max_resampled_rows
 // rows; returns empty signals otherwise.
-ResampledSignals resample_linear(std::span<const double> time, const std::vector<std::vector<double>>& columns,
+ResampledSignals resample_linear(std::span<const double> time, const std::vector<Column>& columns,
                                  double step);
 
 // The whole record resampled on its time column (which must increase strictly); the time

@@ -155,6 +155,29 @@ class NumpyInOut(Workspace):
         self.assertIsNotNone(residuals.base)
         self.assertEqual(residuals.dtype, np.float64)
 
+    def test_contiguous_float64_is_borrowed_not_copied(self):
+        # The record borrows a contiguous float64 array (a reference held while the result lives);
+        # a strided one and a float32 one are copied or converted, so nothing of theirs is held.
+        record = {k: np.ascontiguousarray(v) for k, v in read_record(self.csv).items()}
+        strided = read_record(self.csv)
+        before = {k: sys.getrefcount(record[k]) for k in record}
+        strided_before = {k: sys.getrefcount(strided[k]) for k in strided}
+        model = sidc.compile(self.model_path)
+        result = model.fit(record, no_validate=True)
+        other = model.fit(strided, no_validate=True)
+        # The columns the model reads (its x is a formula of t); the others are let go with the record.
+        used = {"t", "y"}
+        self.assertLess(used, set(record))
+        for k in record:
+            self.assertEqual(sys.getrefcount(record[k]), before[k] + (k in used), k)
+            self.assertEqual(sys.getrefcount(strided[k]), strided_before[k], k)
+        self.assertEqual(result.estimates, other.estimates)
+        # residuals() evaluates the borrowed record again: the same numbers as the copied one's.
+        np.testing.assert_array_equal(result.residuals["residual"], other.residuals["residual"])
+        del result
+        for k in record:
+            self.assertEqual(sys.getrefcount(record[k]), before[k], k)
+
     def test_record_is_not_changed(self):
         record = {k: np.ascontiguousarray(v) for k, v in read_record(self.csv).items()}
         before = {k: v.copy() for k, v in record.items()}

@@ -74,7 +74,7 @@ TEST(Fit, EquationsSharingNoParameterAreSolvedSeparately) {
 TEST(Fit, WeightsScaleTheResidualsAsEquation216) {
   const ir::Model m = compiled("input x\noutput y\nparam a1, a2\na1*y' + a2*y = x\n");
   SampledRecord r = first_order_record(0.5, 2.0, 0.3);
-  for (std::size_t k = 0; k < r.time.size(); ++k) r.signals["x"][k] += 0.01 * std::sin(97.0 * static_cast<double>(k));  // noise
+  for (std::size_t k = 0; k < r.time.size(); ++k) r.signals["x"].owned()[k] += 0.01 * std::sin(97.0 * static_cast<double>(k));  // noise
   auto plain = fit(m, {r}, {});
   r.weights.assign(r.time.size(), 2.0);
   auto doubled = fit(m, {r}, {});

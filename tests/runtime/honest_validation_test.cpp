@@ -106,10 +106,10 @@ TEST(InitialStateEstimate, RecoversTheExactStateOfAnExactRecord) {
   const SampledRecord record = noisy_oscillator(m, f, 0.0, 1);
   SimulateOptions o;
   o.parameters = kTrue;
-  o.time = record.time;
+  o.time = record.time.to_vector();
   o.substeps = 10;
   o.initial["y"] = {1.1, 0.5};  // a poor guess
-  const InitialStateEstimate e = estimate_initial_state(m, f, o, {record.signals.at("y")}, 100);
+  const InitialStateEstimate e = estimate_initial_state(m, f, o, {record.signals.at("y").to_vector()}, 100);
   EXPECT_NEAR(e.initial.at("y")[0], 1.0, 1e-6);
   EXPECT_NEAR(e.initial.at("y")[1], 0.0, 1e-5);
   EXPECT_LT(e.cost_after, 1e-9 * e.cost_before);

@@ -51,7 +51,7 @@ std::vector<double> column_values(const Record& r, std::string_view name) {
     ADD_FAILURE() << render(*d);
     return {};
   }
-  return *std::get<const std::vector<double>*>(result);
+  return std::get<const Column*>(result)->to_vector();
 }
 
 TEST(Records, CommaHeaderAndRows) {

@@ -127,7 +127,7 @@ TEST(StreamedFit, AutomaticArcsPerRecordAgreeWithTheDenseFit) {
   std::vector<SampledRecord> records{appendix_a(m), appendix_a(m)};
   // Deterministic noise of about 0.1% and 1% of y's spread on the two records.
   for (std::size_t r = 0; r < 2; ++r) {
-    auto& y = records[r].signals.at("y");
+    auto& y = records[r].signals.at("y").owned();
     for (std::size_t i = 0; i < y.size(); ++i) y[i] += (r ? 1e-2 : 1e-3) * std::sin(1e3 * static_cast<double>(i) * (1.0 + 0.37 * static_cast<double>(r)));
   }
   FitOptions o;
@@ -224,7 +224,7 @@ TEST(StreamedFit, TheSameDiagnosticForAValueThatIsNotFinite) {
   // log(y) is NaN where y < 0: both paths must blame the same term at the same time.
   const ir::Model m = compiled_text("log.sid", "input x\noutput y\nparam a, b\nset to = 0.82\na*y' + b*log(y + 1) = x\n");
   SampledRecord r = appendix_a(m);
-  for (double& y : r.signals["y"]) y -= 0.8;  // y + 1 < 0 somewhere inside the window
+  for (double& y : r.signals["y"].owned()) y -= 0.8;  // y + 1 < 0 somewhere inside the window
   const auto dense = fit(m, {r}, thesis_options());
   const auto stream = fit(m, {r}, streamed(thesis_options(), 3));
   ASSERT_TRUE(std::holds_alternative<Diagnostic>(dense));
@@ -362,6 +362,51 @@ TEST(BindRecord, MovingTheRecordGivesWhatCopyingGives) {
     EXPECT_EQ(a.weights, a.signals.at("y"));
     EXPECT_EQ(a.time.size(), every == 1 ? 5u : 3u);
   }
+}
+
+// Records handed over in memory (the Python module's numpy arrays) are borrowed, not copied: the
+// bound record reads the lender's memory, and a column written to makes its own copy first.
+TEST(BindRecord, BorrowedColumnsAreReadInPlaceAndNeverWritten) {
+  const ir::Model m = compiled_text("b.sid", "input x\noutput y\nparam a1, a2\na1*y' + a2*y = x\n");
+  const std::vector<std::vector<double>> lent{{0, 0.1, 0.2, 0.3, 0.4}, {1, 1.5, 1.25, 1, 0.5}, {2, 2.5, 2.75, 3, 3.5}};
+  auto keep_alive = std::make_shared<int>(0);
+  const auto as_record = [&] {
+    Record r;
+    r.path = "<arrays>";
+    r.names = {"t", "x", "y"};
+    for (const auto& values : lent) r.columns.push_back(Column::borrowed(values, keep_alive));
+    r.first_faults.resize(3);
+    r.line_jumps = {{0, 0}};
+    return r;
+  };
+  auto copied_text = parse_csv("t,x,y\n0,1,2\n0.1,1.5,2.5\n0.2,1.25,2.75\n0.3,1,3\n0.4,0.5,3.5\n", "mem.csv");
+  ASSERT_TRUE(std::holds_alternative<Record>(copied_text));
+  for (int every : {1, 2}) {
+    BindOptions options;
+    options.every = every;
+    auto borrowed = bind_record(as_record(), ir::DataSource{}, m, options);
+    auto owned = bind_record(std::get<Record>(copied_text), ir::DataSource{}, m, options);
+    ASSERT_TRUE(std::holds_alternative<SampledRecord>(borrowed) && std::holds_alternative<SampledRecord>(owned));
+    const auto& b = std::get<SampledRecord>(borrowed);
+    const auto& o = std::get<SampledRecord>(owned);
+    EXPECT_EQ(b.time, o.time);
+    EXPECT_EQ(b.signals, o.signals);
+    // Every sample kept: the very memory lent; every other one: columns of its own.
+    EXPECT_EQ(b.signals.at("y").data() == lent[2].data(), every == 1);
+    EXPECT_EQ(b.time.is_borrowed(), every == 1);
+    EXPECT_EQ(keep_alive.use_count(), every == 1 ? 4 : 1);  // t, x, y hold it, besides this test
+  }
+  EXPECT_EQ(keep_alive.use_count(), 1);  // released with the last column
+
+  Column y = Column::borrowed(lent[2], keep_alive);
+  const Column shared = y;  // a copy shares the borrowed memory
+  EXPECT_EQ(shared.data(), lent[2].data());
+  y.owned()[0] = -1;  // written: a copy of its own first
+  EXPECT_EQ(lent[2][0], 2);
+  EXPECT_EQ(y[0], -1);
+  EXPECT_NE(y.data(), lent[2].data());
+  EXPECT_EQ(shared[0], 2);
+  EXPECT_EQ(std::move(y).release(), (std::vector<double>{-1, 2.5, 2.75, 3, 3.5}));
 }
 
 }  // namespace

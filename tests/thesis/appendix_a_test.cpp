@@ -45,7 +45,7 @@ Rows appendix() {
   auto r = read_csv(std::string(SIDC_SOURCE_DIR) + "/examples/thesis-4-1/appendix_a.csv");
   EXPECT_TRUE(std::holds_alternative<Record>(r));
   const Record& record = std::get<Record>(r);
-  return {*record.column("t"), *record.column("y")};
+  return {record.column("t")->to_vector(), record.column("y")->to_vector()};
 }
 
 SimulationSummary regenerate(int substeps, SimulateOptions::Method method = SimulateOptions::Method::rk4) {

@@ -20,9 +20,7 @@
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
 #include "driver/fit_run.hpp"
-#include "report/atomic_file.hpp"
 #include "report/fit_files.hpp"
-#include "report/fit_pictures.hpp"
 #include "report/text_reports.hpp"
 #include "runtime/solve/model_comparison.hpp"
 
@@ -80,33 +78,23 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   if (auto* f = std::get_if<driver::Failure>(&prepared)) return fail(*f);
   driver::FitRun& run = *std::get<std::unique_ptr<driver::FitRun>>(prepared);
   {  // Before any work: no output may overwrite the model, its source or a record.
-    std::vector<std::string> inputs{compiled_path, (fs::path(compiled_path).parent_path() / fs::path(run.compiled.source->name).filename()).string()};
-    for (const auto& s : run.loaded.sources) inputs.push_back(s.path);
     std::vector<std::string> outputs = out_dir.empty() ? std::vector<std::string>{} : fit_file_paths(out_dir);
     outputs.push_back(a.report);
-    for (const auto& output : outputs)
-      if (const auto input = input_overwritten_by(output, inputs); !input.empty())
-        return fail(render(cli_diag::output_is_input(output, input)), exit_code::usage_error);
+    if (auto d = driver::output_overwrites_input(run, outputs)) return fail(render(*d), exit_code::usage_error);
   }
   if (auto f = driver::run_fit(run, print)) return fail(*f);
   const ir::Model& model = run.compiled.integrated;
   const FitSummary& summary = run.summary;
   if (!out_dir.empty()) {
-    auto written = write_fit_files(out_dir, {run.compiled, compiled_path, summary, run.options, run.loaded.records, run.validation, run.residuals,
-                                             run.form_choice ? &*run.form_choice : nullptr, run.refinement ? &*run.refinement : nullptr,
-                                             run.instrumental_variables ? &*run.instrumental_variables : nullptr});
+    auto written = driver::write_files(run, out_dir);
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
     if (paths.size() == 3) std::cerr << "wrote " << paths[0] << ", " << paths[1] << " and " << paths[2] << "\n";
     else std::cerr << "wrote " << paths[0] << " and " << paths[1] << "\n";
   }
   if (!a.plots.empty() || !a.report.empty()) {
-    static const std::vector<ValidationSummary> none;
-    const PictureContext context{run.compiled, compiled_path, summary, run.options, run.loaded.records, run.loaded.sources,
-                                 run.validation ? run.validation->runs : none,
-                                 run.validation ? run.validation->note : std::string("was switched off (--no-validate)"), run.residuals};
     std::vector<std::string> written;
-    if (!write_fit_pictures(context, {a.plots, a.report}, written, error)) return fail(error, exit_code::user_error);
+    if (!driver::write_pictures(run, {a.plots, a.report}, written, error)) return fail(error, exit_code::user_error);
     if (!a.plots.empty()) std::cerr << fmt::format("wrote {} pictures into {}\n", written.size() - (a.report.empty() ? 0 : 1), a.plots);
     if (!a.report.empty()) std::cerr << "wrote " << a.report << "\n";
   }

@@ -1,5 +1,6 @@
 #include "driver/fit_run.hpp"
 
+#include <filesystem>
 #include <fmt/format.h>
 
 #include "compiler/hold_check_pass.hpp"
@@ -9,6 +10,8 @@
 #include "diagnostics/cli_catalogue.hpp"
 #include "ir/queries.hpp"
 #include "ir/settings.hpp"
+#include "report/atomic_file.hpp"
+#include "report/fit_files.hpp"
 #include "report/text_reports.hpp"
 #include "runtime/solve/fitted_values.hpp"
 
@@ -159,6 +162,30 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   run.residuals = analyse_residuals(model, summary, records, o);
   out.report(residual_report(run.residuals));
   return std::nullopt;
+}
+
+std::optional<Diagnostic> output_overwrites_input(const FitRun& run, const std::vector<std::string>& outputs) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(run.model_path).parent_path();
+  std::vector<std::string> inputs{run.model_path, (folder / fs::path(run.compiled.source->name).filename()).string()};
+  for (const auto& s : run.loaded.sources) inputs.push_back(s.path);
+  for (const auto& output : outputs)
+    if (const auto input = input_overwritten_by(output, inputs); !input.empty()) return cli_diag::output_is_input(output, input);
+  return std::nullopt;
+}
+
+std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory) {
+  return write_fit_files(directory, {run.compiled, run.model_path, run.summary, run.options, run.loaded.records, run.validation, run.residuals,
+                                     run.form_choice ? &*run.form_choice : nullptr, run.refinement ? &*run.refinement : nullptr,
+                                     run.instrumental_variables ? &*run.instrumental_variables : nullptr});
+}
+
+bool write_pictures(const FitRun& run, const PictureRequest& request, std::vector<std::string>& written, std::string& error) {
+  static const std::vector<ValidationSummary> none;
+  const PictureContext context{run.compiled, run.model_path, run.summary, run.options, run.loaded.records, run.loaded.sources,
+                               run.validation ? run.validation->runs : none,
+                               run.validation ? run.validation->note : "was switched off (" + run.settings.no_validate_name + ")", run.residuals};
+  return write_fit_pictures(context, request, written, error);
 }
 
 }  // namespace sidc::driver

@@ -23,6 +23,7 @@
 
 #include "driver/failure.hpp"
 #include "driver/record_settings.hpp"
+#include "report/fit_pictures.hpp"
 #include "runtime/refine/refine.hpp"
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
@@ -73,5 +74,14 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
 // Everything else, the report sent to `out` section by section. A rank-deficient fit is no
 // failure here: `run.summary.is_solution_usable()` tells, and each face says it its own way.
 std::optional<Failure> run_fit(FitRun& run, const FitOutput& out);
+
+// What `--out DIR`, `--plots DIR` and `--report FILE` write, for every face the same way.
+// An output that is one of the run's inputs (the model, its source, a record): the error to give
+// before anything is written (after prepare_fit, the inputs are known).
+std::optional<Diagnostic> output_overwrites_input(const FitRun& run, const std::vector<std::string>& outputs);
+// fit.json, residuals.csv and validation.csv into `directory` (report/fit_files.hpp): the paths written.
+std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory);
+// The pictures and the HTML report (report/fit_pictures.hpp); false with `error` (rendered).
+bool write_pictures(const FitRun& run, const PictureRequest& request, std::vector<std::string>& written, std::string& error);
 
 }  // namespace sidc::driver

@@ -331,6 +331,16 @@ FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& 
   return FitHandle(std::get<std::unique_ptr<FitSession>>(std::move(result)));
 }
 
+std::vector<std::string> save(const FitHandle& s, const std::string& out, const std::string& plots, const std::string& report) {
+  std::variant<std::vector<std::string>, std::string> result;
+  {
+    py::gil_scoped_release unlocked;
+    result = save_session(*s, out, plots, report);
+  }
+  if (auto* error = std::get_if<std::string>(&result)) throw DiagnosticError{{}, *error};
+  return std::get<std::vector<std::string>>(std::move(result));
+}
+
 std::string fit_json_text(const FitHandle& s) {
   py::gil_scoped_release unlocked;
   return fit_json_document(*s).dump(1) + "\n";
@@ -494,6 +504,7 @@ PYBIND11_MODULE(_sidc, module) {
       .def_property_readonly("warnings", [](const FitHandle& s) { return s->warnings; })
       .def_property_readonly("usable", [](const FitHandle& s) { return s->run.summary.is_solution_usable(); })
       .def("covariance", &covariance)
+      .def("save", &save, py::arg("out"), py::arg("plots"), py::arg("report"))
       .def("residuals", &residuals);
   module.def("compile_text", &compile_text, py::arg("text"), py::arg("name"));
   module.def("compile_file", &compile_file, py::arg("path"));

@@ -44,6 +44,25 @@ std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel
   return s;
 }
 
+std::variant<std::vector<std::string>, std::string> save_session(const FitSession& session, const std::string& out, const std::string& plots,
+                                                                 const std::string& report) {
+  const driver::FitRun& run = session.run;
+  std::vector<std::string> outputs = out.empty() ? std::vector<std::string>{} : fit_file_paths(out);
+  outputs.push_back(report);
+  if (auto d = driver::output_overwrites_input(run, outputs)) return render(*d);
+  std::vector<std::string> written;
+  if (!out.empty()) {
+    auto files = driver::write_files(run, out);
+    if (auto* d = std::get_if<Diagnostic>(&files)) return render(*d);
+    written = std::get<std::vector<std::string>>(std::move(files));
+  }
+  if (!plots.empty() || !report.empty()) {
+    std::string error;
+    if (!driver::write_pictures(run, {plots, report}, written, error)) return error;
+  }
+  return written;
+}
+
 nlohmann::ordered_json fit_json_document(const FitSession& session) {
   const driver::FitRun& s = session.run;
   return fit_document({s.compiled, s.model_path, s.summary, s.options, s.loaded.records, s.validation, s.residuals,

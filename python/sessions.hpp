@@ -65,6 +65,11 @@ using Failure = std::vector<Diagnostic>;
 // `model` is copied in (the session keeps its own, rewritten into the fitted form).
 std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel& model, std::vector<RecordInput> records, FitSettings settings);
 
+// What `sidc fit --out DIR --plots DIR --report FILE` writes (an empty name: not that one), checked
+// first as the CLI checks it; the files written, or the rendered error.
+std::variant<std::vector<std::string>, std::string> save_session(const FitSession& session, const std::string& out, const std::string& plots,
+                                                                 const std::string& report);
+
 // fit.json's content (report/fit_files.hpp: fit_document).
 nlohmann::ordered_json fit_json_document(const FitSession& session);
 

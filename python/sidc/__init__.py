@@ -136,6 +136,17 @@ class FitResult:
     def report(self):
         return self._handle.report()
 
+    def save(self, out=None, plots=None, report=None):
+        """Write what `sidc fit --out OUT --plots PLOTS --report REPORT` writes: fit.json,
+        residuals.csv and validation.csv into the folder `out`, the pictures (SVG and PNG, drawn
+        by gnuplot) into the folder `plots`, the one-page HTML report to the file `report`; each
+        only when given. Returns the paths written. Files are replaced atomically; an output that
+        is one of the fit's inputs is refused (sidc.ModelError), as the CLI refuses it."""
+        if out is None and plots is None and report is None:
+            raise TypeError("save() needs at least one of out, plots, report")
+        paths = [os.fspath(p) if p is not None else "" for p in (out, plots, report)]
+        return self._handle.save(*paths)
+
     @property
     def usable(self):
         return self._handle.usable

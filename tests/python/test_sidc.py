@@ -130,6 +130,34 @@ class FitAgreesWithCli(Workspace):
         self.assertIn("C1@2", result.estimates)
         self.assertEstimatesEqual(result.estimates, cli)
 
+    def test_save_writes_what_the_cli_writes(self):
+        result = sidc.compile(self.model_path).fit()
+        out = os.path.join(self.dir, "saved")
+        written = result.save(out=out)
+        self.assertEqual(sorted(os.path.basename(p) for p in written), ["fit.json", "residuals.csv", "validation.csv"])
+        with open(os.path.join(out, "fit.json")) as f:
+            self.assertEqual(f.read(), result.to_json())
+        self.assertEqual(result.to_json(), self.cli_fit())
+        with open(os.path.join(out, "residuals.csv")) as f, open(os.path.join(self.dir, "out", "residuals.csv")) as g:
+            self.assertEqual(f.read(), g.read())
+        if shutil.which("gnuplot"):
+            page = os.path.join(self.dir, "fit.html")
+            drawn = result.save(plots=os.path.join(self.dir, "plots"), report=page)
+            self.assertIn(page, drawn)
+            self.assertTrue(any(p.endswith(".svg") for p in drawn))
+            with open(page) as f:
+                self.assertIn("quasi_linear", f.read())
+        # An output that is an input is refused, and the record is left as it was.
+        with open(self.csv) as f:
+            before = f.read()
+        with self.assertRaises(sidc.ModelError) as caught:
+            result.save(report=self.csv)
+        self.assertIn("an input of this run: writing it would destroy it", str(caught.exception))
+        with open(self.csv) as f:
+            self.assertEqual(f.read(), before)
+        with self.assertRaises(TypeError):
+            result.save()
+
     def test_model_text(self):
         with open(self.model_path) as f:
             text = f.read().replace('"appendix_a.csv"', '"%s"' % self.csv)

@@ -20,8 +20,6 @@ using ir::FactorKind;
 using ir::Sum;
 using ir::Term;
 
-Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
-
 // A guard among the term's own factors.
 bool has_guard(const Term& t) {
   return std::any_of(t.factors.begin(), t.factors.end(), [](const auto& f) { return f.first.kind == FactorKind::guard; });
@@ -32,10 +30,10 @@ Sum at_window_start(const Sum& s);
 std::optional<Sum> factor_at_window_start(const Factor& f) {
   switch (f.kind) {
     case FactorKind::signal: {
-      Factor v = make(FactorKind::initial_value, f.name, f.order);  // at = nullopt: t0
+      Factor v = Factor::plain(FactorKind::initial_value, f.name, f.order);  // at = nullopt: t0
       return ir::factor(v);
     }
-    case FactorKind::time: return ir::factor(make(FactorKind::window_start));
+    case FactorKind::time: return ir::factor(Factor::plain(FactorKind::window_start));
     case FactorKind::elapsed:
     case FactorKind::integral: return Sum{};  // both vanish at t0
     case FactorKind::function:
@@ -123,7 +121,7 @@ std::optional<Sum> exact_antiderivative(const Term& t, RemainingTerms& remaining
     const FactorKind kind = rest.factors.empty() ? FactorKind::elapsed : rest.factors[0].first.kind;
     const int power = rest.factors.empty() ? 0 : rest.factors[0].second;
     Term p{constant.coefficient / Number(power + 1), constant.factors, t.span};
-    p.factors.push_back({make(kind), power + 1});
+    p.factors.push_back({Factor::plain(kind), power + 1});
     take(remaining, t);
     return ir::canonical(std::vector<Term>{ir::canonical(p)});
   }

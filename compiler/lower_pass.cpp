@@ -75,8 +75,6 @@ bool has_parameter(const Sum& s, std::string* name = nullptr) {
   return false;
 }
 
-Factor make(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
-
 // The nodes a product builds before like terms merge: every pair of terms, with both factor lists.
 std::size_t product_nodes(const Sum& a, const Sum& b) {
   std::size_t factors_a = 0, factors_b = 0;
@@ -150,7 +148,7 @@ struct Lowerer {
       decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1, std::nullopt});
       index = static_cast<int>(decl.model.parameters.size()) - 1;
     }
-    return ir::factor(make(FactorKind::parameter, name, index), 1, where);
+    return ir::factor(Factor::plain(FactorKind::parameter, name, index), 1, where);
   }
 
   // ---- operands -------------------------------------------------------------------------------
@@ -189,15 +187,15 @@ struct Lowerer {
           report(diag::derivative_of_constant(where, name));
           return {};
         }
-        return ir::factor(make(FactorKind::window_start), 1, where);
+        return ir::factor(Factor::plain(FactorKind::window_start), 1, where);
       }
-      Sum s = ir::factor(make(name == "t" ? FactorKind::time : FactorKind::elapsed), 1, where);
+      Sum s = ir::factor(Factor::plain(name == "t" ? FactorKind::time : FactorKind::elapsed), 1, where);
       return order == 0 ? s : differentiate(s, order).value_or(Sum{});
     }
     if (ir::Signal* s = decl.model.signal(name)) {
       if (!context.signals) return not_allowed(where, name);
       s->used = true;
-      return ir::factor(make(FactorKind::signal, name, order), 1, where);
+      return ir::factor(Factor::plain(FactorKind::signal, name, order), 1, where);
     }
     if (decl.families.count(name)) {
       report(diag::family_needs_index(where, name));
@@ -280,7 +278,7 @@ struct Lowerer {
   }
 
   Sum operator()(const ast::Guard& g) {
-    Factor f = make(FactorKind::guard);
+    Factor f = Factor::plain(FactorKind::guard);
     for (const auto& c : g.conditions) {
       Sum lhs = lower(c.lhs), rhs = lower(c.rhs);
       std::string name;
@@ -301,7 +299,7 @@ struct Lowerer {
       f.conditions.push_back({ir::share(std::move(lhs)), r, ir::share(std::move(rhs))});
     }
     std::sort(f.conditions.begin(), f.conditions.end(), [](const ir::Condition& a, const ir::Condition& b) {
-      Factor x = make(FactorKind::guard), y = make(FactorKind::guard);
+      Factor x = Factor::plain(FactorKind::guard), y = Factor::plain(FactorKind::guard);
       x.conditions = {a};
       y.conditions = {b};
       return ir::compare(x, y) < 0;
@@ -422,7 +420,7 @@ struct Lowerer {
       report(diag::bad_initial_value(where, s.name));
       return {};
     }
-    Factor f = make(FactorKind::initial_value, s.name, order);
+    Factor f = Factor::plain(FactorKind::initial_value, s.name, order);
     // `y(t0)`: at the start of the fit window; otherwise a constant time.
     const auto& arg = c.arguments[0];
     const auto* variable = arg.rest.empty() ? boost::get<ast::Variable>(&arg.first.get()) : nullptr;

@@ -3,6 +3,7 @@
 // model or a record (exit code 1).
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "diagnostics/diagnostic.hpp"
@@ -13,5 +14,7 @@ struct Failure {
   std::vector<Diagnostic> diagnostics;
   bool bad_setting = false;
 };
+
+inline Failure failure(Diagnostic d, bool bad_setting = false) { return Failure{{std::move(d)}, bad_setting}; }
 
 }  // namespace sidc::driver

@@ -18,8 +18,6 @@
 namespace sidc::driver {
 namespace {
 
-Failure failure(Diagnostic d, bool bad_setting = false) { return Failure{{std::move(d)}, bad_setting}; }
-
 // The model names no form: each is fitted, and the weak form, the most accurate on known-truth
 // records (docs/accuracy.md), is kept unless another's solved equations follow the record better
 // on every piece of it (form_choice.hpp). Without validation there is nothing to judge them by.

@@ -11,8 +11,6 @@
 namespace sidc::driver {
 namespace {
 
-Failure failure(Diagnostic d, bool bad_setting = false) { return Failure{{std::move(d)}, bad_setting}; }
-
 // An option's name as the face spells it: `--keep-drift` on the command line, `keep_drift` as a keyword.
 std::string option_name(const SelectSettings& s, std::string name) {
   if (!s.keywords) return "--" + name;

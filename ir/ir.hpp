@@ -62,6 +62,9 @@ struct Factor {
 
   // True when the factor does not change with time (t0, initial values, functions of those).
   bool is_constant_in_time() const;
+
+  // A factor of `kind` with its name and order only (a signal, a parameter, t, ...).
+  static Factor plain(FactorKind kind, std::string name = {}, int order = 0) { return Factor{kind, std::move(name), order, {}, {}, {}, {}}; }
 };
 
 int compare(const Factor& a, const Factor& b);

@@ -12,13 +12,12 @@
 #include "ir/traversal.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "runtime/operators/signal_operator.hpp"
+#include "runtime/not_a_number.hpp"
 
 namespace sidc {
 namespace {
 
 using ir::FactorKind;
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
 
@@ -42,7 +41,7 @@ std::variant<WholeWindowValues, Diagnostic> prepare_whole_window_values(const Sa
         return ir::Step::stop;
       }
       auto& v = std::get<std::vector<double>>(values);
-      if (f.kind == FactorKind::initial_value) whole.initial_values[key] = v.empty() ? nan : v.front();
+      if (f.kind == FactorKind::initial_value) whole.initial_values[key] = v.empty() ? kNaN : v.front();
       else whole.integrals[key] = std::move(v);
       return ir::Step::over;
     });

@@ -11,14 +11,13 @@
 #include "ir/traversal.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "runtime/operators/piecewise_inputs.hpp"
+#include "runtime/not_a_number.hpp"
 #include <stdexcept>
 
 namespace sidc {
 namespace {
 
 using ir::FactorKind;
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 std::size_t index_at_or_after(std::span<const double> time, double t) {
   const double tolerance = 1e-9 * std::max(1.0, std::abs(t));
@@ -30,7 +29,7 @@ std::size_t index_at_or_after(std::span<const double> time, double t) {
 void apply_condition(ir::Relation relation, std::span<const double> lhs, std::span<const double> rhs, std::span<double> guard) {
   for (std::size_t i = 0; i < guard.size(); ++i) {
     if (std::isnan(lhs[i]) || std::isnan(rhs[i])) {
-      guard[i] = nan;
+      guard[i] = kNaN;
       continue;
     }
     const bool holds = relation == ir::Relation::less ? lhs[i] < rhs[i]
@@ -226,7 +225,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
         auto intervals = interval_integrals(*f.argument, 0);
         if (auto* d = std::get_if<Diagnostic>(&intervals)) return *d;
         const Values& q = std::get<Values>(intervals);
-        Values v(n, nan);
+        Values v(n, kNaN);
         if (window_.size() > 0) v[window_.first] = 0;
         for (std::size_t i = 0; i < q.size(); ++i) v[window_.first + i + 1] = v[window_.first + i] + q[i];
         return composite_[key] = std::move(v);
@@ -234,7 +233,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
       auto argument = evaluate(*f.argument);
       if (auto* d = std::get_if<Diagnostic>(&argument)) return *d;
       const Values& a = std::get<Values>(argument);
-      Values v(n, nan);
+      Values v(n, kNaN);
       if (f.kind == FactorKind::derivative) {
         auto estimate = derivative_operator(options_, f.order, key)->apply(a, record_.step);
         if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;

@@ -7,11 +7,10 @@
 #include <tuple>
 
 #include "diagnostics/data_catalogue.hpp"
+#include "runtime/not_a_number.hpp"
 
 namespace sidc {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The least-squares weights for unit spacing. With offsets x_i = i - position scaled to
 // s_i = x_i / scale (|s_i| <= 1, which keeps the Vandermonde matrix A well conditioned), the

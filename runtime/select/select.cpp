@@ -21,12 +21,11 @@
 #include "runtime/select/sequential_threshold.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 #include "runtime/solve/weak_design.hpp"
+#include "runtime/not_a_number.hpp"
 
 namespace sidc {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -13,11 +13,10 @@
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/operators/point_evaluator.hpp"
 #include "runtime/operators/savitzky_golay.hpp"
+#include "runtime/not_a_number.hpp"
 
 namespace sidc {
 namespace {
-
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
 std::string prime(const std::string& name, int order) { return name + std::string(static_cast<std::size_t>(order), '\''); }
 
@@ -437,7 +436,7 @@ class System {
         if (time.size() < 2) return v[0];
         return v[k] + (v[k + 1] - v[k]) * (t - time[k]) / (time[k + 1] - time[k]);
     }
-    return nan;
+    return kNaN;
   }
 
   const ExplicitForm* form_ = nullptr;
@@ -550,7 +549,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
   summary.outputs.resize(form.outputs.size());
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {
     summary.output_names.push_back(form.outputs[j].name);
-    summary.outputs[j].assign(n, nan);
+    summary.outputs[j].assign(n, kNaN);
   }
   State s = state_vector(form, o.initial);
   s.resize(system.vector_size(), 0.0);
@@ -561,7 +560,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
     // d x(t0) / d x0 = I: the initial state's columns follow the parameters'.
     for (std::size_t m = 0; m < n_state; ++m) s[n_state + (o.parameters.size() + m) * n_state + m] = 1;
     summary.sensitivity.resize(form.outputs.size());
-    for (auto& column : summary.sensitivity) column.assign(n * columns, nan);
+    for (auto& column : summary.sensitivity) column.assign(n * columns, kNaN);
   }
   auto record = [&](std::size_t row, const State& x) {
     for (std::size_t j = 0; j < form.outputs.size(); ++j) {
@@ -638,7 +637,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
   } else {
     namespace odeint = boost::numeric::odeint;
     auto rhs = [&](const State& x, State& dx, double t) {
-      if (!system.derivative(t, x.data(), dx.data())) std::fill(dx.begin(), dx.end(), nan);
+      if (!system.derivative(t, x.data(), dx.data())) std::fill(dx.begin(), dx.end(), kNaN);
     };
     const double first_step = n > 1 ? (o.time[1] - o.time[0]) / 10 : 1e-3;
     // An adaptive stepper creeping towards a singularity takes ever smaller steps and never

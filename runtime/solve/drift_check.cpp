@@ -11,6 +11,7 @@
 
 #include "diagnostics/model_catalogue.hpp"
 #include "ir/print.hpp"
+#include "runtime/not_a_number.hpp"
 
 namespace sidc {
 namespace {
@@ -37,8 +38,6 @@ Eigen::MatrixXd basis(const Eigen::VectorXd& s, int degree, const Eigen::MatrixX
   if (absorbed.cols() > 0) V.rightCols(absorbed.cols()) = absorbed;  // a 0 x 0 "none" cannot be assigned to n x 0
   return V;
 }
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
 

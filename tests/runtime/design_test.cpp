@@ -14,7 +14,7 @@
 namespace sidc {
 namespace {
 
-ir::Model compiled(const std::string& text) {
+ir::Model design_model(const std::string& text) {
   const auto r = compile(std::make_shared<const SourceFile>("design_test.sid", text), {});
   EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
   return r.ok() ? *r.integrated : ir::Model{};
@@ -38,7 +38,7 @@ SampledRecord record(double phase, std::size_t n) {
 const char* kIntegrated = "input x\noutput y\nparam a1, a2\nset integrate = 1\na1*y' + a2*y = x\n";
 
 TEST(Design, ColumnsCarryTheirParameterAndRecord) {
-  const ir::Model m = compiled(kIntegrated);
+  const ir::Model m = design_model(kIntegrated);
   const std::vector<SampledRecord> records{record(0.3, 501), record(1.7, 401)};
   const DesignBuilder design(m, records, {0});
   EXPECT_EQ(design.column_names(), (std::vector<std::string>{"a1", "a2", "C1@1", "C1@2"}));
@@ -64,7 +64,7 @@ class IndexValues final : public DesignValues {
 };
 
 TEST(Design, AnEquationsRowsGoToItsParametersColumnsForItsRecord) {
-  const ir::Model m = compiled(kIntegrated);
+  const ir::Model m = design_model(kIntegrated);
   const std::vector<SampledRecord> records{record(0.3, 501), record(1.7, 401)};
   const DesignBuilder design(m, records, {0});
   Eigen::MatrixXd A = Eigen::MatrixXd::Constant(3, 4, -1.0);
@@ -84,7 +84,7 @@ TEST(Design, AnEquationsRowsGoToItsParametersColumnsForItsRecord) {
 }
 
 TEST(Design, RowWeightsAreTheColumnTimesTheExpression) {
-  const ir::Model m = compiled(kIntegrated);
+  const ir::Model m = design_model(kIntegrated);
   std::vector<SampledRecord> records{record(0.3, 10)};
   const DesignBuilder unweighted(m, records, {0});
   std::vector<double> out(3);
@@ -100,7 +100,7 @@ TEST(Design, RowWeightsAreTheColumnTimesTheExpression) {
 }
 
 TEST(Design, EstimatesCarryTheirParameterIndexDenseAndStreamed) {
-  const ir::Model m = compiled(kIntegrated);
+  const ir::Model m = design_model(kIntegrated);
   const std::vector<SampledRecord> records{record(0.3, 2001), record(1.7, 1501)};
   FitOptions streamed;
   streamed.stream_above_entries = 0;
@@ -124,7 +124,7 @@ TEST(Design, EstimatesCarryTheirParameterIndexDenseAndStreamed) {
 }
 
 TEST(Design, SelectionsCarryTheSameIndices) {
-  const ir::Model m = compiled("input x\noutput y\nparam a1, a2, a3\nset integrate = 1\na1*y' + a2*y + a3*y^3 = x\n");
+  const ir::Model m = design_model("input x\noutput y\nparam a1, a2, a3\nset integrate = 1\na1*y' + a2*y + a3*y^3 = x\n");
   const std::vector<SampledRecord> records{record(0.3, 2001), record(1.7, 1501)};
   auto result = select_operations(m, records, {});
   ASSERT_TRUE(std::holds_alternative<SelectSummary>(result)) << render(std::get<Diagnostic>(result));

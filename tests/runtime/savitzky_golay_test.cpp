@@ -15,7 +15,7 @@
 namespace sidc {
 namespace {
 
-const std::string kData = std::string(SIDC_SOURCE_DIR) + "/tests/runtime/data/";
+const std::string kCoefficientData = std::string(SIDC_SOURCE_DIR) + "/tests/runtime/data/";
 
 std::vector<double> weights_of(int window, int polyorder, int derivative, int position = -1, double delta = 1.0) {
   auto result = savitzky_golay_weights({window, polyorder, derivative, position, delta});
@@ -90,7 +90,7 @@ std::vector<double> rationals(const std::string& list) {
 
 TEST(SavitzkyGolayWeights, CentralCoefficientsFileEveryRow) {
   std::vector<std::string> header;
-  const auto rows = read_table(kData + "central_coefficients.csv", header);
+  const auto rows = read_table(kCoefficientData + "central_coefficients.csv", header);
   ASSERT_EQ(rows.size(), 12u);
   const std::vector<std::string> cells = {"c_m3", "c_m2", "c_m1", "c_0", "c_p1", "c_p2", "c_p3"};
   for (const auto& row : rows) {
@@ -112,7 +112,7 @@ TEST(SavitzkyGolayWeights, CentralCoefficientsFileEveryRow) {
 
 TEST(SavitzkyGolayWeights, ScipyExamplesEveryRow) {
   std::vector<std::string> header;
-  const auto rows = read_table(kData + "scipy_examples.csv", header);
+  const auto rows = read_table(kCoefficientData + "scipy_examples.csv", header);
   ASSERT_EQ(rows.size(), 21u);
   int checked = 0;
   std::vector<std::string> skipped;

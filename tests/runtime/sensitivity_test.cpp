@@ -18,19 +18,19 @@ using testing::grid;
 using testing::normalized;
 
 
-SimulationSummary run(const ir::Model& m, const ExplicitForm& f, const SimulateOptions& o) {
+SimulationSummary solved(const ir::Model& m, const ExplicitForm& f, const SimulateOptions& o) {
   auto r = simulate(m, f, o);
   EXPECT_TRUE(std::holds_alternative<SimulationSummary>(r)) << render(std::get<Diagnostic>(r));
   return std::get<SimulationSummary>(r);
 }
 
-// Every sensitivity column against (run(q + h) - run(q - h)) / 2h; returns the largest error
+// Every sensitivity column against (solved(q + h) - solved(q - h)) / 2h; returns the largest error
 // relative to the column's largest magnitude.
 double largest_sensitivity_error(const ir::Model& m, const SimulateOptions& base) {
   const ExplicitForm f = form_of(m);
   SimulateOptions o = base;
   o.sensitivities = true;
-  const SimulationSummary exact = run(m, f, o);
+  const SimulationSummary exact = solved(m, f, o);
   EXPECT_TRUE(exact.completed()) << exact.message;
   const std::size_t columns = exact.sensitivity_columns;
   EXPECT_EQ(columns, m.parameters.size() + f.state_size());
@@ -43,7 +43,7 @@ double largest_sensitivity_error(const ir::Model& m, const SimulateOptions& base
       SimulateOptions p = base;
       if (q < m.parameters.size()) p.parameters[q] += h;
       else p.initial[state[q - m.parameters.size()].first][static_cast<std::size_t>(state[q - m.parameters.size()].second)] += h;
-      return run(m, f, p);
+      return solved(m, f, p);
     };
     const double h = 1e-6;
     const SimulationSummary up = shifted(h), down = shifted(-h);

@@ -22,9 +22,11 @@
 #include "runtime/solve/weak_design.hpp"
 
 namespace sidc {
+
+using Index = Eigen::Index;  // as best_subset.cpp and the least-squares files say it
+
 namespace {
 
-using Eigen::Index;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 

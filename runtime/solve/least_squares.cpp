@@ -66,10 +66,12 @@ constexpr const char* kQuadName = "quad (Boost cpp_bin_float_quad)";
 #endif
 
 namespace sidc {
+
+using Index = Eigen::Index;
+
 namespace {
 
 using Ext = ExtendedScalar;
-using Index = Eigen::Index;
 template <class T>
 using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
 template <class T>

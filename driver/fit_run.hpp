@@ -8,10 +8,11 @@
 // out section by section as it is known, through FitOutput, which the command line prints at once
 // and the Python module keeps.
 //
-// Relies on: compiler/ (the rewrites), runtime/ (everything computed), report/text_reports.hpp
-// (the tables printed after the fit's own report). Guarantees: every problem is a Failure holding
-// the Diagnostics the command line prints, never an exception; nothing is written to a file, and
-// nothing to stdout or stderr except through FitOutput.
+// Relies on: compiler/ (the rewrites), runtime/ (everything computed), report/ (the tables printed
+// after the fit's own report; the files and pictures of write_files and write_pictures).
+// Guarantees: every problem is a Failure (or Diagnostic) holding what the command line prints, never
+// an exception; nothing is written to a file but by write_files and write_pictures, and nothing to
+// stdout or stderr except through FitOutput.
 #pragma once
 
 #include <functional>

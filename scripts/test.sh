@@ -12,7 +12,7 @@
 #
 # The sanitizer pass, and why it is a subset. CI is a fresh clone on a 2-core machine and the
 # whole command should stay under 15 minutes; the Release build and suite take about 8 of them
-# with a cold compiler cache (16.5 in all: README, section Tests). The sanitizer tree is one build serving both the sanitizers and the
+# with a cold compiler cache (about 16 in all: README, section Tests). The sanitizer tree is one build serving both the sanitizers and the
 # fuzz targets (Clang, -O1 -gline-tables-only: -O0 code runs the tests about 3 times slower, -g
 # costs link time and disk), and it builds and runs what finds memory and undefined-behaviour
 # errors where hostile input arrives: every layer's library, the sidc binary, the unit tests of

@@ -310,18 +310,24 @@ using FitHandle = std::shared_ptr<FitSession>;  // never changed after the fit
 FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& kwargs) {
   const Keywords k("fit", kwargs, with_record_keywords({"integrate", "form", "no_validate", "validate", "validate_samples", "initial_state",
                                                          "refine", "estimator"}));
-  FitSettings s;
+  driver::FitSettings s;
   s.records = record_settings(k);
-  if (auto* v = k.get("integrate")) s.integrate = py::str(*v).cast<std::string>();  // 0..8 or "auto", checked as --integrate is
-  k.text("form", s.form, {"derivative", "integrated", "weak"});
-  if (!s.form.empty() && !s.integrate.empty()) value_error(cli_diag::invalid_options("`form` and `integrate` exclude each other (as `--form` and `--integrate` do): give one of them"));
+  std::string integrate, form, initial_state;
+  if (auto* v = k.get("integrate")) integrate = py::str(*v).cast<std::string>();  // 0..8 or "auto", checked as --integrate is
+  k.text("form", form, {"derivative", "integrated", "weak"});
+  if (!form.empty() && !integrate.empty()) value_error(cli_diag::invalid_options("`form` and `integrate` exclude each other (as `--form` and `--integrate` do): give one of them"));
   k.flag("no_validate", s.no_validate);
   if (auto* v = k.get("validate")) s.validate = record_inputs(*v);
   k.integer("validate_samples", s.validate_samples, 0);
-  k.text("initial_state", s.initial_state, {"estimate", "record"});
+  k.text("initial_state", initial_state, {"estimate", "record"});
+  if (initial_state == "record") s.initial_state = InitialState::record;
   k.flag("refine", s.refine);
   k.text("estimator", s.estimator, {"least_squares", "iv"});
+  s.no_validate_name = "no_validate";
   auto records = record_inputs(data);
+  auto request = driver::integration_request(integrate, form);  // as sidc fit reads --integrate and --form
+  if (auto* d = std::get_if<Diagnostic>(&request)) raise({*d});
+  s.form = std::get<std::optional<ir::IntegrationRequest>>(request);
   std::variant<std::unique_ptr<FitSession>, Failure> result;
   {
     py::gil_scoped_release unlocked;

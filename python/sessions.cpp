@@ -21,19 +21,8 @@ driver::FitOutput kept(std::string& report, std::vector<std::string>& warnings) 
 
 }  // namespace
 
-std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel& loaded, std::vector<RecordInput> inputs, FitSettings a) {
-  auto request = driver::integration_request(a.integrate, a.form);
-  if (auto* d = std::get_if<Diagnostic>(&request)) return failure(*d);
-  driver::FitSettings settings;
-  settings.records = a.records;
-  settings.form = std::get<std::optional<ir::IntegrationRequest>>(request);
-  settings.no_validate = a.no_validate;
-  settings.validate = std::move(a.validate);
-  settings.validate_samples = a.validate_samples;
-  settings.initial_state = a.initial_state == "record" ? InitialState::record : InitialState::estimate;
-  settings.refine = a.refine;
-  settings.estimator = a.estimator;
-  settings.no_validate_name = "no_validate";
+std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel& loaded, std::vector<RecordInput> inputs,
+                                                               driver::FitSettings settings) {
   auto s = std::make_unique<FitSession>();
   const driver::FitOutput out = kept(s->report, s->warnings);
   auto prepared = driver::prepare_fit(loaded.compiled, loaded.path, loaded.directory, std::move(inputs), std::move(settings), out);

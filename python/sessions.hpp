@@ -38,18 +38,6 @@ struct LoadedModel {
 using driver::RecordInput;
 using driver::RecordSettings;
 
-// `sidc fit`'s options as keywords; `integrate` and `form` as given, read by the session.
-struct FitSettings {
-  RecordSettings records;
-  std::string integrate, form;  // --integrate N|auto, --form derivative|integrated|weak
-  bool no_validate = false;
-  std::vector<RecordInput> validate;  // records only compared with
-  std::size_t validate_samples = 100000;
-  std::string initial_state = "estimate";
-  bool refine = false;
-  std::string estimator;  // "", least_squares, iv
-};
-
 using SelectSettings = driver::SelectSettings;
 
 // Everything one fit produced (driver/fit_run.hpp), with what `sidc fit` would print.
@@ -63,7 +51,7 @@ struct FitSession {
 using Failure = std::vector<Diagnostic>;
 
 // `model` is copied in (the session keeps its own, rewritten into the fitted form).
-std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel& model, std::vector<RecordInput> records, FitSettings settings);
+std::variant<std::unique_ptr<FitSession>, Failure> fit_session(const LoadedModel& model, std::vector<RecordInput> records, driver::FitSettings settings);
 
 // What `sidc fit --out DIR --plots DIR --report FILE` writes (an empty name: not that one), checked
 // first as the CLI checks it; the files written, or the rendered error.

@@ -346,6 +346,21 @@ Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size
                            "(`set from`/`set to`), fewer parameters, or `set edges = shorten`", margin));
 }
 
+Diagnostic local_window_too_long(std::string_view record, double width, double samples, std::size_t available, double span) {
+  return error("local-window-too-long", {},
+               fmt::format("the local window of {:g} ({:g} samples) is longer than the fit window of `{}` ({} samples)", width, samples,
+                           record, available),
+               fmt::format("give a window of at most {:g}, or fit the whole record without --local", span));
+}
+
+Diagnostic local_window_too_short(std::string_view record, double width, std::size_t samples, std::size_t rows,
+                                  std::size_t parameters, double least_width) {
+  return error("local-window-too-short", {},
+               fmt::format("the local window of {:g} ({} samples of `{}`) holds at most {} rows for {} parameters", width, samples, record,
+                           rows, parameters),
+               fmt::format("give a window of at least {:g} (many times that for estimates worth having), or fewer parameters", least_width));
+}
+
 Diagnostic weak_form_mixed(const Span& where) {
   return error("weak-form-mixed", where,
                "this equation shares parameters with an equation of the weak form but is not of the weak form itself",

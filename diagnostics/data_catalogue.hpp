@@ -106,5 +106,10 @@ Diagnostic weak_form_mixed(const Span& where);
 Diagnostic weak_form_too_short(std::string_view record, std::size_t samples, std::size_t needed, std::size_t rows);
 // `set weights = <expression>` (eq. 2-1.6) is negative, NaN or infinite on a row of the fit window.
 Diagnostic weight_not_valid(const Span& where, std::string_view weights, double value, double time, std::string_view record);
+// A local fit's window (`sidc fit --local`, `set local`) longer than the record's fit window, or
+// with fewer rows than the parameters it must determine.
+Diagnostic local_window_too_long(std::string_view record, double width, double samples, std::size_t available, double span);
+Diagnostic local_window_too_short(std::string_view record, double width, std::size_t samples, std::size_t rows,
+                                  std::size_t parameters, double least_width);
 
 }  // namespace sidc::diag

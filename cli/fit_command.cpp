@@ -7,6 +7,8 @@
 #include "cli/fit_command.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
@@ -42,6 +44,9 @@ struct FitArguments {
   std::string report;                 // --report FILE.html
   bool refine = false;                // --refine: output-error refinement after the linear fit
   std::string estimator;              // --estimator least_squares|iv, over the model's `set estimator`
+  std::optional<double> local;        // --local WIDTH: local fits (thesis chapter V), over `set local`
+  std::size_t stride = 1;             // --stride S
+  std::optional<double> forget;       // --forget LAMBDA
 };
 
 // The compiled model to fit when none is named: the only *.sidc.json in the current directory, so
@@ -72,6 +77,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   settings.initial_state = a.initial_state == "record" ? InitialState::record : InitialState::estimate;
   settings.refine = a.refine;
   settings.estimator = a.estimator;
+  settings.local = a.local;
+  settings.stride = a.stride;
+  settings.forget = a.forget;
   const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; }};
   auto prepared = driver::prepare_fit(std::move(*compiled), compiled_path, fs::path(compiled_path).parent_path().string(), record_inputs(a.records),
                                       std::move(settings), print);
@@ -89,8 +97,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     auto written = driver::write_files(run, out_dir);
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
-    if (paths.size() == 3) std::cerr << "wrote " << paths[0] << ", " << paths[1] << " and " << paths[2] << "\n";
-    else std::cerr << "wrote " << paths[0] << " and " << paths[1] << "\n";
+    std::string list;
+    for (std::size_t i = 0; i < paths.size(); ++i) list += (i == 0 ? "" : i + 1 == paths.size() ? " and " : ", ") + paths[i];
+    std::cerr << "wrote " << list << "\n";
   }
   if (!a.plots.empty() || !a.report.empty()) {
     std::vector<std::string> written;
@@ -159,6 +168,15 @@ void add_fit_command(CLI::App& app, int& exit_status) {
       ->check(CLI::IsMember({"least_squares", "iv"}));
   cmd->add_option("--plots", a->plots, "Directory for the pictures (SVG and PNG, drawn by gnuplot): outputs, errors, functions, residual tests");
   cmd->add_option("--report", a->report, "Write a one-page HTML report with the fit's tables and pictures to this file");
+  cmd->add_option("--local", a->local,
+                  "Also fit the model on every window of this width (in time) along each record: slowly varying parameters "
+                  "(thesis chapter V); writes local.csv with --out, a picture per parameter with --plots")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(CLI::Range(std::size_t{1}, std::numeric_limits<std::size_t>::max()));
+  cmd->add_option("--forget", a->forget,
+                  "Local estimates by exponential forgetting instead of windows: each sample's rows weighted lambda^age, "
+                  "0 < LAMBDA < 1 (memory about 1/(1 - LAMBDA) samples)")
+      ->check(CLI::Range(std::nextafter(0.0, 1.0), std::nextafter(1.0, 0.0)));
   cmd->add_flag("--refine", a->refine,
                 "Refine the parameters by the output error: Levenberg-Marquardt over the parameters and each record's initial state, "
                 "minimising the difference between the records and the solved equations (as `set refine = simulation`)");

@@ -228,6 +228,16 @@ Diagnostic option_for_other_method(std::string_view option, std::string_view met
   return message("option-for-other-method", fmt::format("`{}` is for `--method {}`", option, method), std::string(hint));
 }
 
+Diagnostic stride_without_local_fit() {
+  return message("stride-without-local-fit", "`--stride` spaces the local fits, but none was asked for",
+                 "add `--local WIDTH` (windows along the record) or `--forget LAMBDA` (recursive estimates), or drop `--stride`");
+}
+
+Diagnostic local_and_forget() {
+  return message("local-and-forget", "`--local` (windows of a fixed width) and `--forget` (exponential forgetting) are two ways of the same thing",
+                 "give one of them");
+}
+
 Diagnostic step_with_record() {
   return message("step-with-record",
                  "`--step` makes a time grid for a run without a record, but the simulation has one (`--data` or the model's data statement)",

@@ -66,6 +66,9 @@ Diagnostic initial_order_too_high(std::string_view text, std::string_view name, 
 Diagnostic record_as_model(std::string_view path);
 Diagnostic cannot_validate(std::string_view record, const Diagnostic& why);
 Diagnostic rank_deficient();
+// `--stride` without `--local` or `--forget`; `--local` with `--forget` (sidc fit, issue 18).
+Diagnostic stride_without_local_fit();
+Diagnostic local_and_forget();
 Diagnostic pictures_of_several_models(std::size_t models);
 // A warning: the instrumental-variable iteration (`--estimator iv`) did not converge; `statement`
 // says what happened and which estimate is kept (runtime/solve/instrumental_variables.hpp).

@@ -67,6 +67,10 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
     m.form_from_data = false;
     c.integrated = std::move(m);
   }
+  const FitSettings& f = run->settings;
+  if (f.stride != 1 && !f.local && !f.forget && !local_width_setting(c.integrated.settings))
+    return failure(cli_diag::stride_without_local_fit(), true);
+  if (f.local && f.forget) return failure(cli_diag::local_and_forget(), true);
   auto options = fit_options(c.integrated, run->settings.records);
   if (auto* d = std::get_if<Diagnostic>(&options)) return failure(*d, true);
   run->options = std::get<FitOptions>(options);
@@ -159,6 +163,19 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   }
   run.residuals = analyse_residuals(model, summary, records, o);
   out.report(residual_report(run.residuals));
+
+  // Local fits (thesis chapter V): the same rows, window by window along each record.
+  const std::optional<double> width = a.local ? a.local : a.forget ? std::nullopt : local_width_setting(model.settings);
+  if (width || a.forget) {
+    LocalFitOptions lo;
+    lo.width = width.value_or(0);
+    lo.stride = a.stride;
+    lo.forget = a.forget;
+    auto local = local_fit(model, records, o, lo);
+    if (auto* d = std::get_if<Diagnostic>(&local)) return failure(*d, a.local.has_value());
+    run.local = std::get<LocalFitSummary>(std::move(local));
+    out.report("\n" + run.local->report());
+  }
   return std::nullopt;
 }
 
@@ -175,14 +192,16 @@ std::optional<Diagnostic> output_overwrites_input(const FitRun& run, const std::
 std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory) {
   return write_fit_files(directory, {run.compiled, run.model_path, run.summary, run.options, run.loaded.records, run.validation, run.residuals,
                                      run.form_choice ? &*run.form_choice : nullptr, run.refinement ? &*run.refinement : nullptr,
-                                     run.instrumental_variables ? &*run.instrumental_variables : nullptr});
+                                     run.instrumental_variables ? &*run.instrumental_variables : nullptr,
+                                     run.local ? &*run.local : nullptr});
 }
 
 bool write_pictures(const FitRun& run, const PictureRequest& request, std::vector<std::string>& written, std::string& error) {
   static const std::vector<ValidationSummary> none;
   const PictureContext context{run.compiled, run.model_path, run.summary, run.options, run.loaded.records, run.loaded.sources,
                                run.validation ? run.validation->runs : none,
-                               run.validation ? run.validation->note : "was switched off (" + run.settings.no_validate_name + ")", run.residuals};
+                               run.validation ? run.validation->note : "was switched off (" + run.settings.no_validate_name + ")", run.residuals,
+                               run.local ? &*run.local : nullptr};
   return write_fit_pictures(context, request, written, error);
 }
 

@@ -29,6 +29,7 @@
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/instrumental_variables.hpp"
+#include "runtime/solve/local_fit.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc::driver {
@@ -44,6 +45,11 @@ struct FitSettings {
   bool refine = false;
   std::string estimator;                      // "", least_squares or iv: over the model's `set estimator`
   std::string no_validate_name = "--no-validate";  // how the face names that option in the report
+  // Local fits (runtime/solve/local_fit.hpp, thesis chapter V): windows of `local` (time; over the
+  // model's `set local`) every `stride` samples, or with `forget` = lambda recursive estimates.
+  std::optional<double> local;
+  std::size_t stride = 1;
+  std::optional<double> forget;
 };
 
 // Where the text goes as it is known: `report` takes what `sidc fit` prints on stdout, `warning` one
@@ -65,6 +71,7 @@ struct FitRun {
   std::optional<RefineSummary> refinement;
   std::optional<FitValidation> validation;
   ResidualAnalysis residuals;
+  std::optional<LocalFitSummary> local;
 };
 
 // The model rewritten as `settings.form` asks (its warnings sent to `out`), the fit's options and
@@ -80,7 +87,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out);
 // An output that is one of the run's inputs (the model, its source, a record): the error to give
 // before anything is written (after prepare_fit, the inputs are known).
 std::optional<Diagnostic> output_overwrites_input(const FitRun& run, const std::vector<std::string>& outputs);
-// fit.json, residuals.csv and validation.csv into `directory` (report/fit_files.hpp): the paths written.
+// fit.json, residuals.csv, validation.csv and local.csv into `directory` (report/fit_files.hpp): the paths written.
 std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory);
 // The pictures and the HTML report (report/fit_pictures.hpp); false with `error` (rendered).
 bool write_pictures(const FitRun& run, const PictureRequest& request, std::vector<std::string>& written, std::string& error);

@@ -29,7 +29,7 @@ std::optional<int> whole_number(const std::string& text) {
 const std::vector<std::string>& setting_keys() {
   static const std::vector<std::string> keys{"integrate", "form", "constants", "derivative", "second_derivative", "edges",
                                              "integration", "smooth_before_integration", "from", "to", "every", "step", "weights", "refine",
-                                             "estimator", "time_unit"};
+                                             "estimator", "time_unit", "local"};
   return keys;
 }
 
@@ -93,6 +93,8 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
     if (!ir::parse_unit(value, &error))
       r.expected = "a unit of time such as `s`, `min` or `ms` (" + error.message + " at character " +
                    std::to_string(error.offset + 1) + ")";
+  } else if (key == "local") {
+    if (!positive_number(value)) r.expected = "the width of the local fits' window, in time, e.g. `2.5` (sidc fit --local, thesis chapter V)";
   } else if (key == "step") {
     if (!positive_number(value)) r.expected = "a positive sampling step, e.g. `0.01`";
   } else {
@@ -110,6 +112,12 @@ void request_form(ir::IntegrationRequest& request, const std::string& form) {
   request.weak = form == "weak";
   request.count = form == "integrated" ? ir::IntegrationRequest::Count::automatic : ir::IntegrationRequest::Count::fixed;
   request.times = 0;
+}
+
+std::optional<double> local_width_setting(const ir::Settings& settings) {
+  auto it = settings.values.find("local");
+  if (it == settings.values.end()) return std::nullopt;
+  return Number::parse(it->second.text)->value();
 }
 
 Estimator estimator_setting(const ir::Settings& settings) {

@@ -67,6 +67,10 @@ EvaluationSettings evaluation_settings(const ir::Settings& settings);
 enum class Estimator { least_squares, instrumental_variables };
 Estimator estimator_setting(const ir::Settings& settings);
 
+// `set local = WIDTH`: sidc fit also fits the model on every window of that width along the
+// records (runtime/solve/local_fit.hpp), as `--local WIDTH` asks.
+std::optional<double> local_width_setting(const ir::Settings& settings);
+
 // Reads `savgol(7, 3)` or `savgol(auto)`; nullopt if the text is not of that form with a valid
 // window and order.
 std::optional<MovingArc> parse_moving_arc(const std::string& text);

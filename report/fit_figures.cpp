@@ -216,4 +216,28 @@ Figure residual_cross_correlation_figure(const ResidualCorrelationSummary& summa
   return figure;
 }
 
+Figure local_estimate_figure(const std::string& parameter, const std::string& stem_suffix, const SignalLabel& time, const std::string& what,
+                             const std::vector<double>& t, const std::vector<double>& estimate, const std::vector<double>& standard_error,
+                             std::size_t most) {
+  Figure figure;
+  figure.name = "local_" + figure_stem(parameter) + stem_suffix;
+  figure.title = fmt::format("Local estimate of {} along the record, {} (thesis chapter V)", parameter, what);
+  figure.x_label = time.axis() + " (window centre)";
+  figure.y_label = parameter;
+  const std::size_t every = std::max<std::size_t>(1, (t.size() + most - 1) / std::max<std::size_t>(most, 1));
+  Curve value{parameter, {}, {}, Curve::Style::line}, low{"95% band", {}, {}, Curve::Style::dashed_line}, high{"", {}, {}, Curve::Style::dashed_line};
+  for (std::size_t k = 0; k < t.size(); k += every) {
+    const double band = 1.96 * standard_error[k];
+    value.x.push_back(t[k]);
+    value.y.push_back(estimate[k]);
+    low.x.push_back(t[k]);
+    low.y.push_back(estimate[k] - band);
+    high.x.push_back(t[k]);
+    high.y.push_back(estimate[k] + band);
+  }
+  figure.curves = {std::move(value), std::move(low), std::move(high)};
+  if (every > 1) figure.notes.push_back(fmt::format("every {}th window of {} drawn", every, t.size()));
+  return figure;
+}
+
 }  // namespace sidc

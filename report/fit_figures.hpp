@@ -103,4 +103,11 @@ Figure residual_cross_correlation_figure(const ResidualCorrelationSummary& summa
 // primes become 'p' ("y'" -> "yp").
 std::string figure_stem(const std::string& name);
 
+// Thesis chapter V: one parameter's local estimates along a record (sidc fit --local), with its 95%
+// band (estimate +- 1.96 standard errors) dashed; windows without an estimate are gaps. At most
+// `most` points are drawn (every k-th window), so a record of 10^6 windows stays a light picture.
+Figure local_estimate_figure(const std::string& parameter, const std::string& stem_suffix, const SignalLabel& time, const std::string& what,
+                             const std::vector<double>& t, const std::vector<double>& estimate, const std::vector<double>& standard_error,
+                             std::size_t most = 2000);
+
 }  // namespace sidc

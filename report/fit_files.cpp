@@ -37,6 +37,67 @@ bool write_residuals(std::ostream& out, const ir::Model& model, const std::vecto
 
 }  // namespace
 
+bool write_local_csv(std::ostream& out, const LocalFitSummary& local) {
+  if (local.groups.empty()) return static_cast<bool>(out);
+  const std::size_t records = local.groups.front().records.size();
+  const bool several_groups = local.groups.size() > 1;
+  fmt::memory_buffer buffer;
+  auto put = [&](double v) {
+    if (std::isfinite(v)) fmt::format_to(std::back_inserter(buffer), ",{}", v);
+    else buffer.push_back(',');  // no estimate: the rank says why
+  };
+  out << (records > 1 ? "record," : "") << "t_center";
+  for (std::size_t g = 0; g < local.groups.size(); ++g) {
+    for (const auto& name : local.groups[g].columns) out << "," << name << "," << name << "_se";
+    const std::string suffix = several_groups ? fmt::format("_{}", g + 1) : "";
+    out << ",G" << suffix << ",n" << suffix << ",rank" << suffix;
+  }
+  out << "\n";
+  for (std::size_t r = 0; r < records; ++r) {
+    const LocalRecordFit& first = local.groups.front().records[r];
+    for (std::size_t k = 0; k < first.windows(); ++k) {
+      if (records > 1) fmt::format_to(std::back_inserter(buffer), "{},", first.path);
+      fmt::format_to(std::back_inserter(buffer), "{}", first.t_center[k]);
+      for (const auto& g : local.groups) {
+        const LocalRecordFit& fit = g.records[r];
+        const std::size_t p = g.columns.size();
+        for (std::size_t j = 0; j < p; ++j) {
+          put(fit.estimates[k * p + j]);
+          put(fit.standard_errors[k * p + j]);
+        }
+        put(fit.G[k]);
+        fmt::format_to(std::back_inserter(buffer), ",{},{}", fit.n[k], fit.rank[k]);
+      }
+      buffer.push_back('\n');
+      if (buffer.size() > (1u << 16)) {
+        out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+        buffer.clear();
+        if (!out) return false;
+      }
+    }
+  }
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  return static_cast<bool>(out);
+}
+
+nlohmann::ordered_json local_json(const LocalFitSummary& l) {
+  using nlohmann::ordered_json;
+  ordered_json records = ordered_json::array();
+  if (!l.groups.empty())
+    for (const auto& r : l.groups.front().records)
+      records.push_back({{"record", r.path}, {"windows", r.windows()}, {"window_samples", r.window_samples}});
+  return {{"width", l.options.forget ? ordered_json(nullptr) : ordered_json(l.options.width)},
+          {"stride", l.options.stride},
+          {"forget", l.options.forget ? ordered_json(*l.options.forget) : ordered_json(nullptr)},
+          {"records", std::move(records)},
+          {"rank_deficient_windows", l.rank_deficient},
+          {"fresh_factors", l.fresh_factors},
+          {"refused_downdates", l.refused_downdates},
+          {"border_checks", l.drift_checks},
+          {"largest_relative_difference_updated_vs_fresh", l.max_drift},
+          {"file", "local.csv"}};
+}
+
 nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, const std::string& compiled_path, const FitOptions& o) {
   using nlohmann::ordered_json;
   const ir::Model& m = c.integrated;
@@ -263,7 +324,7 @@ nlohmann::ordered_json refinement_json(const RefineSummary& r) {
 
 std::vector<std::string> fit_file_paths(const std::string& directory) {
   const fs::path d(directory);
-  return {(d / "fit.json").string(), (d / "residuals.csv").string(), (d / "validation.csv").string()};
+  return {(d / "fit.json").string(), (d / "residuals.csv").string(), (d / "validation.csv").string(), (d / "local.csv").string()};
 }
 
 std::string select_file_path(const std::string& directory) { return (fs::path(directory) / "select.json").string(); }
@@ -284,6 +345,7 @@ nlohmann::ordered_json fit_document(const FitFiles& f) {
   json["form_choice"] = std::move(choice);
   json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
   json["instrumental_variables"] = f.instrumental_variables ? instrumental_variables_json(*f.instrumental_variables) : nlohmann::ordered_json(nullptr);
+  json["local"] = f.local ? local_json(*f.local) : nlohmann::ordered_json(nullptr);
   non_finite_as_strings(json);
   return json;
 }
@@ -296,6 +358,7 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   const std::string& json_path = paths[0];
   const std::string& csv_path = paths[1];
   const std::string& validation_path = paths[2];
+  const std::string& local_path = paths[3];
   const auto json = fit_document(f);
   const bool curves = f.validation && !f.validation->runs.empty();
   std::string why;
@@ -308,10 +371,15 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   if (!set.add(json_path, json.dump(1) + "\n", &why) ||
       !set.add(csv_path, [&](std::ostream& out) { return write_residuals(out, model, f.records, f.options, f.summary, problem); }, &why) ||
       (curves && !set.add(validation_path, validation_csv(*f.validation), &why)) ||
-      !set.commit(&why, curves ? std::vector<std::string>{} : std::vector<std::string>{validation_path}))
+      (f.local && !set.add(local_path, [&](std::ostream& out) { return write_local_csv(out, *f.local); }, &why)))
     return problem ? *problem : cli_diag::cannot_write(why);
+  std::vector<std::string> stale;
+  if (!curves) stale.push_back(validation_path);
+  if (!f.local) stale.push_back(local_path);
+  if (!set.commit(&why, stale)) return cli_diag::cannot_write(why);
   std::vector<std::string> written{json_path, csv_path};
   if (curves) written.push_back(validation_path);
+  if (f.local) written.push_back(local_path);
   return written;
 }
 

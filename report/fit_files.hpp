@@ -21,6 +21,7 @@
 #include "runtime/refine/refine.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/instrumental_variables.hpp"
+#include "runtime/solve/local_fit.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc {
@@ -56,18 +57,28 @@ struct FitFiles {
   // The instrumental-variable estimate (`--estimator iv`, `set estimator = iv`); null otherwise
   // (fit.json's `instrumental_variables` is then null).
   const InstrumentalVariablesSummary* instrumental_variables = nullptr;
+  // The local fits (`--local`, `--forget`, `set local`); null otherwise (fit.json's `local` is then
+  // null and no local.csv is written).
+  const LocalFitSummary* local = nullptr;
 };
+
+// local.csv: one row per window (record, when several, then t_center, each parameter and its
+// standard error, G, n and rank per group); a window without estimates (rank < parameters) has
+// empty estimate cells. Written as the rows are formatted, never held whole.
+bool write_local_csv(std::ostream& out, const LocalFitSummary& local);
+nlohmann::ordered_json local_json(const LocalFitSummary& local);
 
 // The whole of fit.json (the fit, validation, residual analysis, form choice, refinement and
 // instrumental variables; non-finite numbers as strings): what write_fit_files writes, and what the
 // Python module's `to_json()` returns.
 nlohmann::ordered_json fit_document(const FitFiles& files);
 
-// Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv (creating
-// DIR); the paths written, or the Diagnostic of the first failure (the previous files untouched).
-// A validation.csv of an earlier run is removed when this run writes none.
+// Writes DIR/fit.json, DIR/residuals.csv and, when a validation ran, DIR/validation.csv, when local
+// fits ran, DIR/local.csv (creating DIR); the paths written, or the Diagnostic of the first failure
+// (the previous files untouched). A validation.csv or local.csv of an earlier run is removed when
+// this run writes none.
 std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::string& directory, const FitFiles& files);
-// The paths write_fit_files may write in DIR (fit.json, residuals.csv, validation.csv).
+// The paths write_fit_files may write in DIR (fit.json, residuals.csv, validation.csv, local.csv).
 std::vector<std::string> fit_file_paths(const std::string& directory);
 
 nlohmann::ordered_json select_json(const SelectSummary& summary, const std::string& model_path, const SelectOptions& options);

@@ -235,6 +235,24 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
     for (std::size_t i = 0; i < rc.cross.size(); ++i)
       if (rc.cross[i].computed) figures.push_back({residual_cross_correlation_figure(rc, i, group), static_cast<int>(g)});
   }
+  // Local fits: each parameter against time, per record, in its group's section.
+  if (c.local) {
+    const std::string what = c.local->options.forget ? fmt::format("forgetting lambda = {:g}", *c.local->options.forget)
+                                                     : fmt::format("windows of {:g}", c.local->options.width);
+    for (std::size_t g = 0; g < c.local->groups.size(); ++g) {
+      const LocalGroupFit& group = c.local->groups[g];
+      const std::size_t p = group.columns.size();
+      for (std::size_t r = 0; r < group.records.size(); ++r) {
+        const LocalRecordFit& fit = group.records[r];
+        for (std::size_t j = 0; j < p; ++j) {
+          std::vector<double> x(fit.windows()), se(fit.windows());
+          for (std::size_t k = 0; k < fit.windows(); ++k) x[k] = fit.estimates[k * p + j], se[k] = fit.standard_errors[k * p + j];
+          const std::string on = c.records.size() > 1 ? what + ", " + record_name(fit.path) : what;
+          figures.push_back({local_estimate_figure(group.columns[j], suffix(r), time, on, fit.t_center, x, se), static_cast<int>(g)});
+        }
+      }
+    }
+  }
   return figures;
 }
 
@@ -273,6 +291,7 @@ ReportContent report_content(const PictureContext& c) {
     fill_group_from(group.summary, c.options.least_squares.confidence_level, &out);
     if (g < c.residuals.groups.size())
       out.residual_verdicts.push_back(c.residuals.notes[g].empty() ? c.residuals.groups[g].verdict : c.residuals.notes[g]);
+    if (c.local && g < c.local->groups.size()) out.local_fits = c.local->group_report(g);
     content.groups.push_back(std::move(out));
   }
   // The simulation covers every output at once: its table goes with the first group.

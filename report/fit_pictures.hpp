@@ -12,6 +12,7 @@
 
 #include "ir/compiled_model.hpp"
 #include "runtime/solve/fit.hpp"
+#include "runtime/solve/local_fit.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 #include "runtime/simulate/validate.hpp"
 
@@ -32,6 +33,7 @@ struct PictureContext {
   const std::vector<ValidationSummary>& validations;  // may be empty
   std::string validation_note;                      // why validation did not run, if it did not
   const ResidualAnalysis& residuals;
+  const LocalFitSummary* local = nullptr;           // sidc fit --local: a figure per parameter
 };
 
 // Draws the figures and writes the report; false with `error` set (a message for stderr) when a

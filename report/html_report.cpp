@@ -205,6 +205,8 @@ std::string render_html_report(const ReportContent& content) {
       for (const auto& line : group.residual_verdicts) out += "<li class=\"verdict\">" + html_escape(line) + "</li>\n";
       out += "</ul>\n";
     }
+    if (!group.local_fits.empty())
+      out += "<h3>Local fits (thesis chapter V)</h3>\n<pre>" + html_escape(group.local_fits) + "</pre>\n";
     figures_html(group.figures, &figure_count, out);
   }
 

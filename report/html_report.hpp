@@ -64,6 +64,7 @@ struct ReportGroup {
   ReportStatistics statistics;
   std::vector<ReportValidation> validation;
   std::vector<std::string> residual_verdicts;  // one line each (ResidualCorrelationSummary)
+  std::string local_fits;                      // the local fits' table (sidc fit --local), preformatted; empty: none
   std::vector<ReportFigure> figures;
 };
 

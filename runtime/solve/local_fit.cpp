@@ -428,46 +428,63 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
   return summary;
 }
 
-std::string LocalFitSummary::report() const {
+std::string LocalFitSummary::group_report(std::size_t group) const {
   std::string out;
-  if (options.forget)
-    out += fmt::format("Local fits (thesis chapter V): exponential forgetting, lambda = {} (about {} samples), an estimate every {} sample{}\n",
-                       format_number(*options.forget), groups.empty() || groups[0].records.empty() ? 0 : groups[0].records[0].window_samples,
-                       options.stride, options.stride == 1 ? "" : "s");
-  else
-    out += fmt::format("Local fits (thesis chapter V): windows of {} ({} samples), every {} sample{}\n", format_number(options.width),
-                       groups.empty() || groups[0].records.empty() ? 0 : groups[0].records[0].window_samples, options.stride,
-                       options.stride == 1 ? "" : "s");
-  for (const auto& g : groups) {
-    for (const auto& r : g.records) {
-      const std::size_t p = g.columns.size();
-      out += fmt::format("  {}: {} estimates\n", r.path, r.windows());
-      out += fmt::format("    {:<14} {:>12} {:>12} {:>12} {:>12}\n", "parameter", "min", "median", "max", "median SE");
-      for (std::size_t j = 0; j < p; ++j) {
-        std::vector<double> x, se;
-        for (std::size_t k = 0; k < r.windows(); ++k)
-          if (r.rank[k] == static_cast<int>(p)) {
-            x.push_back(r.estimates[k * p + j]);
-            if (std::isfinite(r.standard_errors[k * p + j])) se.push_back(r.standard_errors[k * p + j]);
-          }
-        auto median = [](std::vector<double> v) {
-          if (v.empty()) return kNaN;
-          std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-          return v[v.size() / 2];
-        };
-        if (x.empty()) {
-          out += fmt::format("    {:<14} {:>12}\n", g.columns[j], "(no window of full rank)");
-          continue;
+  if (group >= groups.size()) return out;
+  const LocalGroupFit& g = groups[group];
+  const std::size_t p = g.columns.size();
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return kNaN;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  for (const auto& r : g.records) {
+    const auto full = static_cast<std::size_t>(std::count(r.rank.begin(), r.rank.end(), static_cast<int>(p)));
+    out += fmt::format("{}: {} estimates ({} of full rank)\n", r.path, r.windows(), full);
+    out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", "parameter", "min", "median", "max", "median SE");
+    for (std::size_t j = 0; j < p; ++j) {
+      std::vector<double> x, se;
+      for (std::size_t k = 0; k < r.windows(); ++k)
+        if (r.rank[k] == static_cast<int>(p)) {
+          x.push_back(r.estimates[k * p + j]);
+          if (std::isfinite(r.standard_errors[k * p + j])) se.push_back(r.standard_errors[k * p + j]);
         }
-        out += fmt::format("    {:<14} {:>12} {:>12} {:>12} {:>12}\n", g.columns[j], format_number(*std::min_element(x.begin(), x.end())),
-                           format_number(median(x)), format_number(*std::max_element(x.begin(), x.end())), format_number(median(se)));
+      if (x.empty()) {
+        out += fmt::format("  {:<14} (no window of full rank)\n", g.columns[j]);
+        continue;
       }
+      out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", g.columns[j], format_number(*std::min_element(x.begin(), x.end())),
+                         format_number(median(x)), format_number(*std::max_element(x.begin(), x.end())), format_number(median(se)));
     }
   }
-  out += fmt::format("  rank deficient: {} window{} (no estimate; `rank` < parameters in local.csv)\n", rank_deficient,
+  return out;
+}
+
+std::string LocalFitSummary::report() const {
+  const std::size_t samples = groups.empty() || groups[0].records.empty() ? 0 : groups[0].records[0].window_samples;
+  std::string out;
+  if (options.forget)
+    out += fmt::format("Local fits (thesis chapter V): exponential forgetting, lambda = {} (a memory of about {} samples), an estimate {}\n",
+                       format_number(*options.forget), samples,
+                       options.stride == 1 ? std::string("at every sample") : fmt::format("every {} samples", options.stride));
+  else
+    out += fmt::format("Local fits (thesis chapter V): windows of {} ({} samples), one {}\n", format_number(options.width), samples,
+                       options.stride == 1 ? std::string("at every sample") : fmt::format("every {} samples", options.stride));
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    std::string numbers;
+    for (std::size_t e : groups[g].equations) numbers += (numbers.empty() ? "" : ", ") + std::to_string(e + 1);
+    if (groups.size() > 1) out += fmt::format("  Equation{} {}\n", groups[g].equations.size() == 1 ? "" : "s", numbers);
+    std::string table = group_report(g);
+    for (std::size_t at = 0; at < table.size();) {
+      const std::size_t end = table.find('\n', at);
+      out += "  " + table.substr(at, end - at + 1);
+      at = end + 1;
+    }
+  }
+  out += fmt::format("  rank deficient: {} window{} (no estimate: `rank` below the parameters in local.csv)\n", rank_deficient,
                      rank_deficient == 1 ? "" : "s");
-  out += fmt::format("  factors: {} fresh, {} downdate{} refused for loss of accuracy; updated against fresh at {} piece border{}: largest "
-                     "relative difference of the estimates {:.2g}\n",
+  out += fmt::format("  factors: {} fresh, {} downdate{} refused for loss of accuracy (refactored); updated against fresh at {} piece "
+                     "border{}: largest relative difference of the estimates {:.2g}\n",
                      fresh_factors, refused_downdates, refused_downdates == 1 ? "" : "s", drift_checks, drift_checks == 1 ? "" : "s", max_drift);
   return out;
 }

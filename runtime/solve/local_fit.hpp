@@ -71,6 +71,7 @@ struct LocalFitSummary {
   double seconds = 0;                  // wall time of the local fits
   int threads = 1;
   std::string report() const;          // the text section of sidc fit's report
+  std::string group_report(std::size_t group) const;  // its table for one group (the HTML report's)
 };
 
 std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, const std::vector<SampledRecord>& records,

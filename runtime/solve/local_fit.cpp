@@ -385,12 +385,13 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
       const auto threads = static_cast<std::size_t>(summary.threads);
       if ((N + slide.per_piece - 1) / slide.per_piece < threads) slide.per_piece = std::max<std::size_t>(1, (N + threads - 1) / threads);
       const std::size_t pieces = (N + slide.per_piece - 1) / slide.per_piece;
-      fit.t_center.assign(N, kNaN);
-      fit.G.assign(N, kNaN);
-      fit.n.assign(N, 0);
-      fit.rank.assign(N, 0);
-      fit.estimates.assign(N * p, kNaN);
-      fit.standard_errors.assign(N * p, kNaN);
+      // Every window is written by exactly one piece (keep()).
+      fit.t_center.resize(N);
+      fit.G.resize(N);
+      fit.n.resize(N);
+      fit.rank.resize(N);
+      fit.estimates.resize(N * p);
+      fit.standard_errors.resize(N * p);
       slide.border.assign(pieces, {});
 
       std::atomic<std::size_t> next{0};
@@ -440,21 +441,33 @@ std::string LocalFitSummary::group_report(std::size_t group) const {
   };
   for (const auto& r : g.records) {
     const auto full = static_cast<std::size_t>(std::count(r.rank.begin(), r.rank.end(), static_cast<int>(p)));
-    out += fmt::format("{}: {} estimates ({} of full rank)\n", r.path, r.windows(), full);
+    // Min and max over every window; medians over at most 10^5 of them, evenly spaced.
+    const std::size_t every = std::max<std::size_t>(1, (r.windows() + 99'999) / 100'000);
+    std::vector<double> low(p, kNaN), high(p, kNaN);
+    std::vector<std::vector<double>> x(p), se(p);
+    for (std::size_t k = 0; k < r.windows(); ++k) {
+      if (r.rank[k] != static_cast<int>(p)) continue;
+      const double* e = &r.estimates[k * p];
+      for (std::size_t j = 0; j < p; ++j) {
+        low[j] = std::isnan(low[j]) ? e[j] : std::min(low[j], e[j]);
+        high[j] = std::isnan(high[j]) ? e[j] : std::max(high[j], e[j]);
+      }
+      if (k % every != 0) continue;
+      for (std::size_t j = 0; j < p; ++j) {
+        x[j].push_back(e[j]);
+        if (std::isfinite(r.standard_errors[k * p + j])) se[j].push_back(r.standard_errors[k * p + j]);
+      }
+    }
+    out += fmt::format("{}: {} estimates ({} of full rank{})\n", r.path, r.windows(), full,
+                       every > 1 ? fmt::format("; medians of every {}th", every) : std::string());
     out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", "parameter", "min", "median", "max", "median SE");
     for (std::size_t j = 0; j < p; ++j) {
-      std::vector<double> x, se;
-      for (std::size_t k = 0; k < r.windows(); ++k)
-        if (r.rank[k] == static_cast<int>(p)) {
-          x.push_back(r.estimates[k * p + j]);
-          if (std::isfinite(r.standard_errors[k * p + j])) se.push_back(r.standard_errors[k * p + j]);
-        }
-      if (x.empty()) {
+      if (std::isnan(low[j])) {
         out += fmt::format("  {:<14} (no window of full rank)\n", g.columns[j]);
         continue;
       }
-      out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", g.columns[j], format_number(*std::min_element(x.begin(), x.end())),
-                         format_number(median(x)), format_number(*std::max_element(x.begin(), x.end())), format_number(median(se)));
+      out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", g.columns[j], format_number(low[j]), format_number(median(x[j])),
+                         format_number(high[j]), format_number(median(se[j])));
     }
   }
   return out;

@@ -25,6 +25,8 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
+#include <utility>
 #include <optional>
 #include <string>
 #include <variant>
@@ -43,13 +45,29 @@ struct LocalFitOptions {
   std::size_t piece_turnovers = 4; // a fresh factor every this many window lengths
 };
 
+// Vectors whose resize leaves new elements uninitialised: the results of 10^6 windows are written
+// once each by the threads, and an initial fill would be a serial pass over a few hundred MB.
+template <class T>
+struct UninitialisedAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  template <class U, class... Args>
+  void construct(U* at, Args&&... args) {
+    if constexpr (sizeof...(Args) == 0) ::new (static_cast<void*>(at)) U;
+    else ::new (static_cast<void*>(at)) U(std::forward<Args>(args)...);
+  }
+};
+using LocalValues = std::vector<double, UninitialisedAllocator<double>>;
+
 // One record's windows for one group.
 struct LocalRecordFit {
   std::string path;
   std::size_t window_samples = 0;          // W (for forgetting: the effective 1 / (1 - lambda))
-  std::vector<double> t_center, G, n;      // per window; n: rows (weighted count with forgetting)
+  LocalValues t_center, G, n;             // per window; n: rows (weighted count with forgetting)
   std::vector<int> rank;
-  std::vector<double> estimates, standard_errors;  // windows x p, row by row; NaN where rank < p
+  LocalValues estimates, standard_errors;  // windows x p, row by row; NaN where rank < p
   std::size_t windows() const { return t_center.size(); }
 };
 

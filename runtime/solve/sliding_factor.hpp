@@ -3,7 +3,7 @@
 // rho kept as rows enter and leave, so that sliding a window along a record costs O(p^2) a row
 // whatever the window's length (runtime/solve/local_fit.hpp).
 //
-// Relies on: Eigen (the triangular solves). The arithmetic is LINPACK's (Dongarra et al. 1979,
+// Relies on: the standard library; plain loops the compiler vectorises. The arithmetic is LINPACK's (Dongarra et al. 1979,
 // ch. 10): a row enters by Givens rotations (dchud); a row leaves by the Saunders downdate (dchdd):
 // a = R^-T x, alpha^2 = 1 - |a|^2, rotations that carry alpha into R's diagonal. Exponential
 // forgetting multiplies the whole factor by sqrt(lambda) (eq. 2-1.6's weights lambda^(age/2)).
@@ -56,6 +56,7 @@ class SlidingFactor {
 
  private:
   double& r(int i, int j) { return R_[static_cast<std::size_t>(i) * static_cast<std::size_t>(p_) + static_cast<std::size_t>(j)]; }
+  const double* row(int i) const { return R_.data() + static_cast<std::size_t>(i) * static_cast<std::size_t>(p_); }
   double r(int i, int j) const { return R_[static_cast<std::size_t>(i) * static_cast<std::size_t>(p_) + static_cast<std::size_t>(j)]; }
 
   int p_;
@@ -64,6 +65,7 @@ class SlidingFactor {
   double rho_ = 0;
   bool rho_lost_ = false;
   std::vector<double> work_, c_, s_;  // remove()'s a, rotations
+  mutable std::vector<double> scratch_, inverse_;  // solve()'s column norms, R^-1
 };
 
 }  // namespace sidc

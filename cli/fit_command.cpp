@@ -7,8 +7,6 @@
 #include "cli/fit_command.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
@@ -156,7 +154,7 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_option("compiled", a->compiled, "Compiled model(s) (.sidc.json), or model files (.sid) to compile first; default: the only compiled model here");
   add_record_options(cmd, a->records);
   add_form_options(cmd, a->form_options);
-  cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv and validation.csv");
+  cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv, validation.csv and (with --local or --forget) local.csv");
   cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all)");
   cmd->add_option("--initial-state", a->initial_state,
                   "The validation's initial state: `estimate` (least squares over the record's start, the default) or `record` "
@@ -172,11 +170,22 @@ void add_fit_command(CLI::App& app, int& exit_status) {
                   "Also fit the model on every window of this width (in time) along each record: slowly varying parameters "
                   "(thesis chapter V); writes local.csv with --out, a picture per parameter with --plots")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(CLI::Range(std::size_t{1}, std::numeric_limits<std::size_t>::max()));
+  cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(CLI::PositiveNumber);
   cmd->add_option("--forget", a->forget,
                   "Local estimates by exponential forgetting instead of windows: each sample's rows weighted lambda^age, "
                   "0 < LAMBDA < 1 (memory about 1/(1 - LAMBDA) samples)")
-      ->check(CLI::Range(std::nextafter(0.0, 1.0), std::nextafter(1.0, 0.0)));
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            double v = 0;
+            try {
+              v = std::stod(text);
+            } catch (...) {
+              return std::string("LAMBDA must be a number between 0 and 1, e.g. 0.999");
+            }
+            return v > 0 && v < 1 ? std::string()
+                                  : std::string("LAMBDA must lie strictly between 0 and 1 (1 forgets nothing: that is the global fit)");
+          },
+          "LAMBDA"));
   cmd->add_flag("--refine", a->refine,
                 "Refine the parameters by the output error: Levenberg-Marquardt over the parameters and each record's initial state, "
                 "minimising the difference between the records and the solved equations (as `set refine = simulation`)");

@@ -348,7 +348,7 @@ Diagnostic window_too_short(std::string_view record, std::size_t rows, std::size
 
 Diagnostic local_window_too_long(std::string_view record, double width, double samples, std::size_t available, double span) {
   return error("local-window-too-long", {},
-               fmt::format("the local window of {:g} ({:g} samples) is longer than the fit window of `{}` ({} samples)", width, samples,
+               fmt::format("the local window of {:g} ({:g} samples) is longer than `{}` can give ({} samples)", width, samples,
                            record, available),
                fmt::format("give a window of at most {:g}, or fit the whole record without --local", span));
 }
@@ -356,8 +356,8 @@ Diagnostic local_window_too_long(std::string_view record, double width, double s
 Diagnostic local_window_too_short(std::string_view record, double width, std::size_t samples, std::size_t rows,
                                   std::size_t parameters, double least_width) {
   return error("local-window-too-short", {},
-               fmt::format("the local window of {:g} ({} samples of `{}`) holds at most {} rows for {} parameters", width, samples, record,
-                           rows, parameters),
+               fmt::format("the local window of {:g} ({} sample{} of `{}`) holds at most {} row{} for {} parameters", width, samples,
+                           samples == 1 ? "" : "s", record, rows, rows == 1 ? "" : "s", parameters),
                fmt::format("give a window of at least {:g} (many times that for estimates worth having), or fewer parameters", least_width));
 }
 

@@ -87,6 +87,13 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   const std::vector<SampledRecord>& records = run.loaded.records;
   const std::string form_report = compiled.integrated.form_from_data ? choose_the_form(run) : "";
   const ir::Model& model = compiled.integrated;
+  const std::optional<double> width = a.local ? a.local : a.forget ? std::nullopt : local_width_setting(model.settings);
+  LocalFitOptions local_options;
+  local_options.width = width.value_or(0);
+  local_options.stride = a.stride;
+  local_options.forget = a.forget;
+  if (width)
+    if (auto d = check_local_window(model, records, local_options)) return failure(*d, a.local.has_value());
 
   auto result = fit(model, records, o);
   if (auto* d = std::get_if<Diagnostic>(&result)) return failure(*d);
@@ -165,13 +172,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   out.report(residual_report(run.residuals));
 
   // Local fits (thesis chapter V): the same rows, window by window along each record.
-  const std::optional<double> width = a.local ? a.local : a.forget ? std::nullopt : local_width_setting(model.settings);
   if (width || a.forget) {
-    LocalFitOptions lo;
-    lo.width = width.value_or(0);
-    lo.stride = a.stride;
-    lo.forget = a.forget;
-    auto local = local_fit(model, records, o, lo);
+    auto local = local_fit(model, records, o, local_options);
     if (auto* d = std::get_if<Diagnostic>(&local)) return failure(*d, a.local.has_value());
     run.local = std::get<LocalFitSummary>(std::move(local));
     out.report("\n" + run.local->report());

@@ -314,6 +314,24 @@ std::string format_number(double v) { return fmt::format("{:.6g}", v); }
 
 }  // namespace
 
+std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local) {
+  if (local.forget) return std::nullopt;
+  for (const auto& record : records) {
+    const std::size_t n = record.time.size();
+    const double samples = std::round(local.width / record.step);
+    if (!(samples <= static_cast<double>(n)))
+      return diag::local_window_too_long(record.path, local.width, samples, n, static_cast<double>(n) * record.step);
+    for (const auto& members : equation_groups(model)) {
+      const std::size_t p = DesignBuilder(model, {record}, members).columns().size();
+      const auto W = static_cast<std::size_t>(std::max(samples, 1.0));
+      if (W * members.size() < p)
+        return diag::local_window_too_short(record.path, local.width, W, W * members.size(), p,
+                                            std::ceil(static_cast<double>(p) / static_cast<double>(members.size())) * record.step);
+    }
+  }
+  return std::nullopt;
+}
+
 std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                     const FitOptions& options, const LocalFitOptions& local) {
   const auto clock = std::chrono::steady_clock::now();

@@ -92,6 +92,10 @@ struct LocalFitSummary {
   std::string group_report(std::size_t group) const;  // its table for one group (the HTML report's)
 };
 
+// Before any work: a window longer than a record, or with fewer rows than a group's parameters
+// even where every sample gives a row (local_fit() checks again on the fit windows).
+std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local);
+
 std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                     const FitOptions& options, const LocalFitOptions& local);
 

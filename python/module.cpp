@@ -309,7 +309,7 @@ using FitHandle = std::shared_ptr<FitSession>;  // never changed after the fit
 
 FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& kwargs) {
   const Keywords k("fit", kwargs, with_record_keywords({"integrate", "form", "no_validate", "validate", "validate_samples", "initial_state",
-                                                         "refine", "estimator"}));
+                                                         "refine", "estimator", "local", "stride", "forget"}));
   driver::FitSettings s;
   s.records = record_settings(k);
   std::string integrate, form, initial_state;
@@ -323,6 +323,11 @@ FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& 
   if (initial_state == "record") s.initial_state = InitialState::record;
   k.flag("refine", s.refine);
   k.text("estimator", s.estimator, {"least_squares", "iv"});
+  k.number("local", s.local, true);
+  k.integer("stride", s.stride, 1);
+  k.number("forget", s.forget, true);
+  if (s.forget && !(*s.forget < 1))
+    value_error(cli_diag::keyword_wrong_type("forget", fmt::format("{}", *s.forget), "a number strictly between 0 and 1"));
   s.no_validate_name = "no_validate";
   auto records = record_inputs(data);
   auto request = driver::integration_request(integrate, form);  // as sidc fit reads --integrate and --form
@@ -389,6 +394,45 @@ py::dict residuals(const FitHandle& s) {
   out["known"] = numpy_owning(std::move(c.known));
   out["fitted"] = numpy_owning(std::move(c.fitted));
   out["residual"] = numpy_owning(std::move(c.residual));
+  return out;
+}
+
+// The local fits as local.csv's columns (None without them): t_center, each parameter and its
+// standard error (NaN where a window has no estimate), G, n, rank (groups after the first with
+// their number appended, as in local.csv), and `record` (an index) when there are several records.
+py::object local_arrays(const FitHandle& s) {
+  if (!s->run.local) return py::none();
+  const LocalFitSummary& l = *s->run.local;
+  py::dict out;
+  std::vector<double> t, record;
+  for (std::size_t r = 0; r < l.groups.front().records.size(); ++r) {
+    const auto& fit = l.groups.front().records[r];
+    t.insert(t.end(), fit.t_center.begin(), fit.t_center.end());
+    record.insert(record.end(), fit.windows(), static_cast<double>(r));
+  }
+  if (l.groups.front().records.size() > 1) out["record"] = numpy_owning(std::move(record));
+  out["t_center"] = numpy_owning(std::move(t));
+  for (std::size_t g = 0; g < l.groups.size(); ++g) {
+    const auto& group = l.groups[g];
+    const std::size_t p = group.columns.size();
+    for (std::size_t j = 0; j < p; ++j) {
+      std::vector<double> x, se;
+      for (const auto& fit : group.records)
+        for (std::size_t k = 0; k < fit.windows(); ++k) x.push_back(fit.estimates[k * p + j]), se.push_back(fit.standard_errors[k * p + j]);
+      out[py::str(group.columns[j])] = numpy_owning(std::move(x));
+      out[py::str(group.columns[j] + "_se")] = numpy_owning(std::move(se));
+    }
+    std::vector<double> G, n, rank;
+    for (const auto& fit : group.records) {
+      G.insert(G.end(), fit.G.begin(), fit.G.end());
+      n.insert(n.end(), fit.n.begin(), fit.n.end());
+      rank.insert(rank.end(), fit.rank.begin(), fit.rank.end());
+    }
+    const std::string suffix = l.groups.size() > 1 ? fmt::format("_{}", g + 1) : "";
+    out[py::str("G" + suffix)] = numpy_owning(std::move(G));
+    out[py::str("n" + suffix)] = numpy_owning(std::move(n));
+    out[py::str("rank" + suffix)] = numpy_owning(std::move(rank));
+  }
   return out;
 }
 
@@ -511,7 +555,8 @@ PYBIND11_MODULE(_sidc, module) {
       .def_property_readonly("usable", [](const FitHandle& s) { return s->run.summary.is_solution_usable(); })
       .def("covariance", &covariance)
       .def("save", &save, py::arg("out"), py::arg("plots"), py::arg("report"))
-      .def("residuals", &residuals);
+      .def("residuals", &residuals)
+      .def("local", &local_arrays);
   module.def("compile_text", &compile_text, py::arg("text"), py::arg("name"));
   module.def("compile_file", &compile_file, py::arg("path"));
   module.def("fit", &run_fit, py::arg("model"), py::arg("data"), py::arg("settings"));

@@ -98,7 +98,7 @@ class Model:
         list of either (several records), or None for the model's data statements. `settings`: the
         options of `sidc fit` (from_, to, every, step, resample, derivative, second_derivative,
         edges, integration, precision, weights, integrate, form, no_validate, validate,
-        validate_samples, initial_state, refine, estimator)."""
+        validate_samples, initial_state, refine, estimator, local, stride, forget)."""
         return FitResult(_sidc.fit(self._handle, data, settings))
 
     def __repr__(self):
@@ -146,6 +146,13 @@ class FitResult:
             raise TypeError("save() needs at least one of out, plots, report")
         paths = [os.fspath(p) if p is not None else "" for p in (out, plots, report)]
         return self._handle.save(*paths)
+
+    @property
+    def local(self):
+        """The local fits (`local=WIDTH` or `forget=LAMBDA`, or the model's `set local`; thesis
+        chapter V) as a dict of numpy arrays named like local.csv's columns (t_center, each
+        parameter, its `_se`, G, n, rank; NaN where a window has no estimate); None without them."""
+        return self._handle.local()
 
     @property
     def usable(self):

@@ -158,6 +158,28 @@ class FitAgreesWithCli(Workspace):
         with self.assertRaises(TypeError):
             result.save()
 
+    def test_local_fits_are_the_clis_local_csv(self):
+        # Issue 18: local fits from the module give local.csv's columns, and save() writes the CLI's file.
+        result = sidc.compile(self.model_path).fit(local=0.3, stride=3, no_validate=True)
+        local = result.local
+        self.assertIsNotNone(local)
+        out = os.path.join(self.dir, "out")
+        done = run_cli("fit", self.model_path, "--no-validate", "--local", "0.3", "--stride", "3", "--out", out)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(out, "local.csv")) as f:
+            header = f.readline().strip().split(",")
+        cli = np.genfromtxt(os.path.join(out, "local.csv"), delimiter=",", skip_header=1)
+        self.assertEqual(list(local), header)
+        for k, name in enumerate(header):  # empty cells (no estimate) read as NaN, as the module gives them
+            np.testing.assert_array_equal(local[name], cli[:, k], err_msg=name)
+        saved = os.path.join(self.dir, "saved")
+        result.save(out=saved)
+        with open(os.path.join(saved, "local.csv")) as f, open(os.path.join(out, "local.csv")) as g:
+            self.assertEqual(f.read(), g.read())
+        self.assertIsNone(sidc.compile(self.model_path).fit(no_validate=True).local)
+        with self.assertRaises(ValueError):
+            sidc.compile(self.model_path).fit(forget=1.0)
+
     def test_model_text(self):
         with open(self.model_path) as f:
             text = f.read().replace('"appendix_a.csv"', '"%s"' % self.csv)

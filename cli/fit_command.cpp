@@ -7,6 +7,7 @@
 #include "cli/fit_command.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <iostream>
@@ -16,6 +17,7 @@
 #include "cli/exit_codes.hpp"
 #include "cli/form_options.hpp"
 #include "cli/output_check.hpp"
+#include "cli/progress_line.hpp"
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
@@ -78,7 +80,12 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   settings.local = a.local;
   settings.stride = a.stride;
   settings.forget = a.forget;
-  const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; }};
+  ProgressLine progress;  // on stderr, only when it is a terminal
+  const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; },
+                                [&progress](const std::string& phase, std::size_t done, std::size_t total) {
+                                  std::cout.flush();
+                                  progress.update(phase, done, total);
+                                }};
   auto prepared = driver::prepare_fit(std::move(*compiled), compiled_path, fs::path(compiled_path).parent_path().string(), record_inputs(a.records),
                                       std::move(settings), print);
   if (auto* f = std::get_if<driver::Failure>(&prepared)) return fail(*f);
@@ -169,7 +176,17 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_option("--local", a->local,
                   "Also fit the model on every window of this width (in time) along each record: slowly varying parameters "
                   "(thesis chapter V); writes local.csv with --out, a picture per parameter with --plots")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            double v = 0;
+            try {
+              v = std::stod(text);
+            } catch (...) {
+              return std::string("WIDTH must be a number of time units, e.g. 2.5");
+            }
+            return std::isfinite(v) && v > 0 ? std::string() : std::string("WIDTH must be a positive, finite number of time units");
+          },
+          "WIDTH"));
   cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(CLI::PositiveNumber);
   cmd->add_option("--forget", a->forget,
                   "Local estimates by exponential forgetting instead of windows: each sample's rows weighted lambda^age, "

@@ -94,7 +94,7 @@ int run_select(const SelectArguments& a) {
     if (const auto input = input_overwritten_by(select_file_path(a.out), inputs); !input.empty())
       return usage(cli_diag::output_is_input(select_file_path(a.out), input));
   }
-  const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; }};
+  const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; }, {}};
   if (auto f = driver::run_select(run, print)) return fail(*f);
   if (!a.out.empty()) {
     auto written = write_select_file(a.out, *run.summary, a.model, run.options);

@@ -1,5 +1,6 @@
 #include "driver/fit_run.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 
@@ -71,6 +72,10 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
   if (f.stride != 1 && !f.local && !f.forget && !local_width_setting(c.integrated.settings))
     return failure(cli_diag::stride_without_local_fit(), true);
   if (f.local && f.forget) return failure(cli_diag::local_and_forget(), true);
+  if (f.local && !(std::isfinite(*f.local) && *f.local > 0))
+    return failure(cli_diag::invalid_options(fmt::format("the local window's width must be a positive number of time units, not {}", *f.local)), true);
+  if (f.forget && !(*f.forget > 0 && *f.forget < 1))
+    return failure(cli_diag::invalid_options(fmt::format("the forgetting factor must lie strictly between 0 and 1, not {}", *f.forget)), true);
   auto options = fit_options(c.integrated, run->settings.records);
   if (auto* d = std::get_if<Diagnostic>(&options)) return failure(*d, true);
   run->options = std::get<FitOptions>(options);
@@ -173,6 +178,10 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
 
   // Local fits (thesis chapter V): the same rows, window by window along each record.
   if (width || a.forget) {
+    if (out.progress)
+      local_options.progress = [&out](const std::string& record, std::size_t done, std::size_t total) {
+        out.progress("local fits of " + record + " (windows)", done, total);
+      };
     auto local = local_fit(model, records, o, local_options);
     if (auto* d = std::get_if<Diagnostic>(&local)) return failure(*d, a.local.has_value());
     run.local = std::get<LocalFitSummary>(std::move(local));

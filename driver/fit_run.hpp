@@ -56,6 +56,8 @@ struct FitSettings {
 // rendered line of what it prints on stderr (without the line's end).
 struct FitOutput {
   std::function<void(const std::string&)> report, warning;
+  // Optional: how far a long phase is (its name, units done, units in all), for a progress line.
+  std::function<void(const std::string& phase, std::size_t done, std::size_t total)> progress;
 };
 
 // One fit, from its model and records to everything it produced.

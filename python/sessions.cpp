@@ -16,7 +16,7 @@ Failure failure(Diagnostic d) { return Failure{std::move(d)}; }
 
 // The text `sidc fit` prints, kept: stdout's as one report, stderr's line by line.
 driver::FitOutput kept(std::string& report, std::vector<std::string>& warnings) {
-  return {[&report](const std::string& text) { report += text; }, [&warnings](const std::string& line) { warnings.push_back(line); }};
+  return {[&report](const std::string& text) { report += text; }, [&warnings](const std::string& line) { warnings.push_back(line); }, {}};
 }
 
 }  // namespace

@@ -23,6 +23,8 @@ struct Curve {
   Style style = Style::line;
   bool right_axis = false;  // drawn against the right-hand y axis (Figure::y2_label): two error
                             // curves of different size in one figure, as Figs. 4-1.8/4-1.9
+  int colour_of = -1;       // drawn in the colour of the figure's curve of this index (the two
+                            // edges of a band); -1: its own
 };
 
 // A shaded horizontal band between two levels, with its edges dashed: the 99% confidence band of

@@ -226,6 +226,7 @@ Figure local_estimate_figure(const std::string& parameter, const std::string& st
   figure.y_label = parameter;
   const std::size_t every = std::max<std::size_t>(1, (t.size() + most - 1) / std::max<std::size_t>(most, 1));
   Curve value{parameter, {}, {}, Curve::Style::line}, low{"95% band", {}, {}, Curve::Style::dashed_line}, high{"", {}, {}, Curve::Style::dashed_line};
+  high.colour_of = 1;  // the band's two edges alike
   for (std::size_t k = 0; k < t.size(); k += every) {
     const double band = 1.96 * standard_error[k];
     value.x.push_back(t[k]);

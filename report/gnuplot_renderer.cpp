@@ -249,7 +249,8 @@ std::string gnuplot_script(const Figure& figure, const RenderOptions& options, c
   for (std::size_t c = 0; c < figure.curves.size(); ++c) {
     const auto& curve = figure.curves[c];
     plots.insert(plots.begin() + static_cast<long>(c),
-                 fmt::format("$c{} using 1:2 {}{} lc {} {}", c, curve.right_axis ? "axes x1y2 " : "", style_clause(curve), c + 1,
+                 fmt::format("$c{} using 1:2 {}{} lc {} {}", c, curve.right_axis ? "axes x1y2 " : "", style_clause(curve),
+                             curve.colour_of >= 0 ? curve.colour_of + 1 : static_cast<int>(c) + 1,
                              curve.label.empty() ? std::string("notitle") : "title " + gnuplot_quote(curve.label)));
   }
   std::string plot = "plot ";

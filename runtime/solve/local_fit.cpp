@@ -50,10 +50,26 @@ class ChunkValues final : public DesignValues {
   const SampledRecord& record_;
 };
 
+// `record` alone, for a design of its own (its own integration constants): its columns borrowed,
+// not copied (a record of 10^7 samples is fitted window by window without a second copy); the
+// caller's record outlives the local fit.
+SampledRecord alone(const SampledRecord& record) {
+  static const auto lent = std::make_shared<const int>(0);  // borrowed memory is the caller's: nothing to keep alive
+  SampledRecord out;
+  out.path = record.path;
+  out.step = record.step;
+  out.time = Column::borrowed(record.time, lent);
+  for (const auto& [name, values] : record.signals) out.signals.emplace(name, Column::borrowed(values, lent));
+  out.columns = record.columns;
+  out.weights = record.weights;
+  out.weights_column = record.weights_column;
+  return out;
+}
+
 // What a record's rows come from, shared read-only by the threads' cursors.
 struct RowSource {
   RowSource(const ir::Model& m, const SampledRecord& record, std::vector<std::size_t> group)
-      : model(m), one{record}, equations(std::move(group)) {}
+      : model(m), one{alone(record)}, equations(std::move(group)) {}
   const ir::Model& model;
   std::vector<SampledRecord> one;  // the record alone: its own integration constants
   EvaluationOptions evaluation;
@@ -322,7 +338,8 @@ std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::
     if (!(samples <= static_cast<double>(n)))
       return diag::local_window_too_long(record.path, local.width, samples, n, static_cast<double>(n) * record.step);
     for (const auto& members : equation_groups(model)) {
-      const std::size_t p = DesignBuilder(model, {record}, members).columns().size();
+      const std::vector<SampledRecord> one{alone(record)};
+      const std::size_t p = DesignBuilder(model, one, members).columns().size();
       const auto W = static_cast<std::size_t>(std::max(samples, 1.0));
       if (W * members.size() < p)
         return diag::local_window_too_short(record.path, local.width, W, W * members.size(), p,
@@ -412,16 +429,18 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
       fit.standard_errors.resize(N * p);
       slide.border.assign(pieces, {});
 
-      std::atomic<std::size_t> next{0};
-      auto work = [&] {
+      std::atomic<std::size_t> next{0}, done{0};
+      auto work = [&](bool caller) {
         for (std::size_t piece = next++; piece < pieces; piece = next++) {
           if (local.forget) slide.forgetting_piece(piece);
           else slide.window_piece(piece);
+          done += std::min(N, (piece + 1) * slide.per_piece) - piece * slide.per_piece;
+          if (caller && local.progress) local.progress(records[r].path, done, N);
         }
       };
       std::vector<std::thread> running;
-      for (std::size_t k = 1; k < std::min(threads, pieces); ++k) running.emplace_back(work);
-      work();
+      for (std::size_t k = 1; k < std::min(threads, pieces); ++k) running.emplace_back(work, false);
+      work(true);
       for (auto& t : running) t.join();
       if (slide.problem) return slide.problem->second;
 

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <utility>
 #include <optional>
@@ -43,6 +44,8 @@ struct LocalFitOptions {
   std::optional<double> forget;    // lambda in (0, 1): exponential forgetting instead of windows
   int threads = 0;                 // 0: one per core, at most 8
   std::size_t piece_turnovers = 4; // a fresh factor every this many window lengths
+  // Called on the calling thread as pieces finish: the record, its windows done and in all.
+  std::function<void(const std::string& record, std::size_t done, std::size_t total)> progress;
 };
 
 // Vectors whose resize leaves new elements uninitialised: the results of 10^6 windows are written

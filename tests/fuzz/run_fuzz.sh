@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target of this folder for a bounded time on a seed corpus taken from the
 # repository: the examples and the bad-input catalogue. Used by CTest (tests/fuzz/CMakeLists.txt,
-# about 45 s each) and by scripts/fuzz.sh (an hour each).
+# about 30 s each) and by scripts/fuzz.sh (an hour each).
 #
 # Usage: run_fuzz.sh FUZZER KIND SECONDS WORK_DIR [SIDC_BINARY]
 #   KIND: model (model files), compiled (compiled models: the seed models compiled by SIDC_BINARY)

@@ -153,6 +153,21 @@ int run_fit(const FitArguments& a) {
   return status;
 }
 
+// A number option's check, with `message` (what it must be) for anything else, text or NaN.
+CLI::Validator number_check(const std::string& name, bool (*holds)(double), const std::string& message) {
+  return CLI::Validator(
+      [holds, message](std::string& text) {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && holds(v)) return std::string();
+        } catch (...) {
+        }
+        return message;
+      },
+      name);
+}
+
 }  // namespace
 
 void add_fit_command(CLI::App& app, int& exit_status) {
@@ -176,33 +191,14 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_option("--local", a->local,
                   "Also fit the model on every window of this width (in time) along each record: slowly varying parameters "
                   "(thesis chapter V); writes local.csv with --out, a picture per parameter with --plots")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            double v = 0;
-            try {
-              v = std::stod(text);
-            } catch (...) {
-              return std::string("WIDTH must be a number of time units, e.g. 2.5");
-            }
-            return std::isfinite(v) && v > 0 ? std::string() : std::string("WIDTH must be a positive, finite number of time units");
-          },
-          "WIDTH"));
+      ->check(number_check("WIDTH", [](double v) { return std::isfinite(v) && v > 0; },
+                           "WIDTH must be a positive, finite number of time units, e.g. 2.5"));
   cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(CLI::PositiveNumber);
   cmd->add_option("--forget", a->forget,
                   "Local estimates by exponential forgetting instead of windows: each sample's rows weighted lambda^age, "
                   "0 < LAMBDA < 1 (memory about 1/(1 - LAMBDA) samples)")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            double v = 0;
-            try {
-              v = std::stod(text);
-            } catch (...) {
-              return std::string("LAMBDA must be a number between 0 and 1, e.g. 0.999");
-            }
-            return v > 0 && v < 1 ? std::string()
-                                  : std::string("LAMBDA must lie strictly between 0 and 1 (1 forgets nothing: that is the global fit)");
-          },
-          "LAMBDA"));
+      ->check(number_check("LAMBDA", [](double v) { return v > 0 && v < 1; },
+                           "LAMBDA must lie strictly between 0 and 1, e.g. 0.999 (1 forgets nothing: that is the global fit)"));
   cmd->add_flag("--refine", a->refine,
                 "Refine the parameters by the output error: Levenberg-Marquardt over the parameters and each record's initial state, "
                 "minimising the difference between the records and the solved equations (as `set refine = simulation`)");

@@ -350,7 +350,7 @@ Diagnostic local_window_too_long(std::string_view record, double width, double s
   return error("local-window-too-long", {},
                fmt::format("the local window of {:g} ({:g} samples) is longer than `{}` can give ({} samples)", width, samples,
                            record, available),
-               fmt::format("give a window of at most {:g}, or fit the whole record without --local", span));
+               fmt::format("give a window of at most {:g}, or leave out the local fits (`--local`, `set local`)", span));
 }
 
 Diagnostic local_window_too_short(std::string_view record, double width, std::size_t samples, std::size_t rows,

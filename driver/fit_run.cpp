@@ -90,15 +90,19 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   const FitSettings& a = run.settings;
   const FitOptions& o = run.options;
   const std::vector<SampledRecord>& records = run.loaded.records;
-  const std::string form_report = compiled.integrated.form_from_data ? choose_the_form(run) : "";
-  const ir::Model& model = compiled.integrated;
-  const std::optional<double> width = a.local ? a.local : a.forget ? std::nullopt : local_width_setting(model.settings);
+  // Local fits asked for: their window checked against the records before any work, and against
+  // the fit windows of the form fitted before the global fit (a setting at fault: exit code 2).
+  const std::optional<double> width = a.local ? a.local : a.forget ? std::nullopt : local_width_setting(compiled.integrated.settings);
   LocalFitOptions local_options;
   local_options.width = width.value_or(0);
   local_options.stride = a.stride;
   local_options.forget = a.forget;
   if (width)
-    if (auto d = check_local_window(model, records, local_options)) return failure(*d, a.local.has_value());
+    if (auto d = check_local_window(compiled.integrated, records, local_options)) return failure(*d, true);
+  const std::string form_report = compiled.integrated.form_from_data ? choose_the_form(run) : "";
+  const ir::Model& model = compiled.integrated;
+  if (width)
+    if (auto d = check_local_window(model, records, local_options, &o)) return failure(*d, true);
 
   auto result = fit(model, records, o);
   if (auto* d = std::get_if<Diagnostic>(&result)) return failure(*d);
@@ -179,11 +183,11 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   // Local fits (thesis chapter V): the same rows, window by window along each record.
   if (width || a.forget) {
     if (out.progress)
-      local_options.progress = [&out](const std::string& record, std::size_t done, std::size_t total) {
-        out.progress("local fits of " + record + " (windows)", done, total);
+      local_options.progress = [&out](const std::string& what, std::size_t done, std::size_t total) {
+        out.progress("local fits of " + what + " (windows)", done, total);
       };
     auto local = local_fit(model, records, o, local_options);
-    if (auto* d = std::get_if<Diagnostic>(&local)) return failure(*d, a.local.has_value());
+    if (auto* d = std::get_if<Diagnostic>(&local)) return failure(*d, true);
     run.local = std::get<LocalFitSummary>(std::move(local));
     out.report("\n" + run.local->report());
   }

@@ -39,6 +39,18 @@ bool write_residuals(std::ostream& out, const ir::Model& model, const std::vecto
 
 }  // namespace
 
+namespace {
+
+// A CSV field as RFC 4180 has it: quoted, its quotes doubled, when it holds a comma, a quote or a line end.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+}  // namespace
+
 bool write_local_csv(std::ostream& out, const LocalFitSummary& local) {
   if (local.groups.empty()) return static_cast<bool>(out);
   const std::size_t records = local.groups.front().records.size();
@@ -60,7 +72,7 @@ bool write_local_csv(std::ostream& out, const LocalFitSummary& local) {
     };
     const LocalRecordFit& front = local.groups.front().records[r];
     for (std::size_t k = first; k < last; ++k) {
-      if (records > 1) fmt::format_to(fmt::appender(buffer), "{},", front.path);
+      if (records > 1) fmt::format_to(fmt::appender(buffer), "{},", csv_field(front.path));
       fmt::format_to(fmt::appender(buffer), "{}", front.t_center[k]);
       for (const auto& g : local.groups) {
         const LocalRecordFit& fit = g.records[r];

@@ -290,6 +290,7 @@ struct Slide {
         }
       }
       if (auto d = in->problem()) return fail(piece, *d);
+      if (auto d = leaving->problem()) return fail(piece, *d);
       const SlidingSolution solution = f.solve(count, tolerance);
       if (k == k1) {
         border[piece] = solution.estimates;
@@ -330,15 +331,26 @@ std::string format_number(double v) { return fmt::format("{:.6g}", v); }
 
 }  // namespace
 
-std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local) {
+std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local,
+                                             const FitOptions* options) {
   if (local.forget) return std::nullopt;
   for (const auto& record : records) {
-    const std::size_t n = record.time.size();
+    std::size_t n = record.time.size();
+    if (options) {  // the fit window: the samples the derivatives leave, within --from/--to
+      auto chosen = operators_for_record(options->evaluation, record, model);
+      if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+      auto window = fit_window(record, model, std::get<EvaluationOptions>(chosen), options->from, options->to);
+      if (auto* d = std::get_if<Diagnostic>(&window)) return *d;
+      n = std::get<FitWindow>(window).size();
+    }
     const double samples = std::round(local.width / record.step);
     if (!(samples <= static_cast<double>(n)))
       return diag::local_window_too_long(record.path, local.width, samples, n, static_cast<double>(n) * record.step);
+    const std::vector<SampledRecord> one{alone(record)};
     for (const auto& members : equation_groups(model)) {
-      const std::vector<SampledRecord> one{alone(record)};
+      auto weak = is_weak_group(model, members);
+      if (auto* d = std::get_if<Diagnostic>(&weak)) return *d;
+      if (std::get<bool>(weak)) continue;  // rows are subdomains, known once chosen: local_fit() checks
       const std::size_t p = DesignBuilder(model, one, members).columns().size();
       const auto W = static_cast<std::size_t>(std::max(samples, 1.0));
       if (W * members.size() < p)
@@ -355,7 +367,8 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
   LocalFitSummary summary;
   summary.options = local;
   summary.threads = thread_count(options, local);
-  for (const auto& members : equation_groups(model)) {
+  const auto all_groups = equation_groups(model);
+  for (const auto& members : all_groups) {
     LocalGroupFit group;
     group.equations = members;
     for (std::size_t r = 0; r < records.size(); ++r) {
@@ -391,7 +404,8 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
       std::size_t span = 0;  // samples a piece must see before its first estimate
       if (local.forget) {
         const double lambda = *local.forget;
-        slide.W = static_cast<std::size_t>(std::ceil(std::log(1e-16) / std::log(lambda)));
+        // Rows this old weigh lambda^(age/2) <= 1e-16 in R (1e-32 in R^T R): below rounding.
+        slide.W = static_cast<std::size_t>(std::ceil(std::log(1e-32) / std::log(lambda)));
         fit.window_samples = static_cast<std::size_t>(std::llround(1 / (1 - lambda)));
         slide.windows = (n - 1) / slide.S + 1;
         span = slide.W;
@@ -417,8 +431,12 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
       }
       const std::size_t N = slide.windows;
       slide.per_piece = std::max<std::size_t>(1, (local.piece_turnovers * span + slide.S - 1) / slide.S);
+      // At least kMostThreads pieces where the windows allow: the layout (and so the last digits,
+      // which depend on where fresh factors start) is the same whatever the machine's cores.
+      constexpr std::size_t kMostThreads = 8;
       const auto threads = static_cast<std::size_t>(summary.threads);
-      if ((N + slide.per_piece - 1) / slide.per_piece < threads) slide.per_piece = std::max<std::size_t>(1, (N + threads - 1) / threads);
+      if ((N + slide.per_piece - 1) / slide.per_piece < kMostThreads)
+        slide.per_piece = std::max<std::size_t>(1, (N + kMostThreads - 1) / kMostThreads);
       const std::size_t pieces = (N + slide.per_piece - 1) / slide.per_piece;
       // Every window is written by exactly one piece (keep()).
       fit.t_center.resize(N);
@@ -429,19 +447,22 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
       fit.standard_errors.resize(N * p);
       slide.border.assign(pieces, {});
 
+      const std::string label =
+          all_groups.size() > 1 ? fmt::format("{}, equation group {}", records[r].path, summary.groups.size() + 1) : records[r].path;
       std::atomic<std::size_t> next{0}, done{0};
       auto work = [&](bool caller) {
         for (std::size_t piece = next++; piece < pieces; piece = next++) {
           if (local.forget) slide.forgetting_piece(piece);
           else slide.window_piece(piece);
           done += std::min(N, (piece + 1) * slide.per_piece) - piece * slide.per_piece;
-          if (caller && local.progress) local.progress(records[r].path, done, N);
+          if (caller && local.progress) local.progress(label, done, N);
         }
       };
       std::vector<std::thread> running;
       for (std::size_t k = 1; k < std::min(threads, pieces); ++k) running.emplace_back(work, false);
       work(true);
       for (auto& t : running) t.join();
+      if (local.progress) local.progress(label, N, N);
       if (slide.problem) return slide.problem->second;
 
       for (std::size_t piece = 0; piece + 1 < pieces; ++piece) {
@@ -482,8 +503,10 @@ std::string LocalFitSummary::group_report(std::size_t group) const {
     const std::size_t every = std::max<std::size_t>(1, (r.windows() + 99'999) / 100'000);
     std::vector<double> low(p, kNaN), high(p, kNaN);
     std::vector<std::vector<double>> x(p), se(p);
+    std::size_t without_se = 0;  // full rank, but n <= p: no residual degrees of freedom
     for (std::size_t k = 0; k < r.windows(); ++k) {
       if (r.rank[k] != static_cast<int>(p)) continue;
+      if (p > 0 && !std::isfinite(r.standard_errors[k * p])) ++without_se;
       const double* e = &r.estimates[k * p];
       for (std::size_t j = 0; j < p; ++j) {
         low[j] = std::isnan(low[j]) ? e[j] : std::min(low[j], e[j]);
@@ -495,8 +518,10 @@ std::string LocalFitSummary::group_report(std::size_t group) const {
         if (std::isfinite(r.standard_errors[k * p + j])) se[j].push_back(r.standard_errors[k * p + j]);
       }
     }
-    out += fmt::format("{}: {} estimates ({} of full rank{})\n", r.path, r.windows(), full,
-                       every > 1 ? fmt::format("; medians of every {}th", every) : std::string());
+    out += fmt::format("{}: {} estimates ({} of full rank{}{}), {} {} samples\n", r.path, r.windows(), full,
+                       without_se ? fmt::format(", {} of them without a standard error: n <= parameters", without_se) : std::string(),
+                       every > 1 ? fmt::format("; medians of every {}th", every) : std::string(),
+                       options.forget ? "a memory of about" : "windows of", r.window_samples);
     out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", "parameter", "min", "median", "max", "median SE");
     for (std::size_t j = 0; j < p; ++j) {
       if (std::isnan(low[j])) {
@@ -504,22 +529,20 @@ std::string LocalFitSummary::group_report(std::size_t group) const {
         continue;
       }
       out += fmt::format("  {:<14} {:>12} {:>12} {:>12} {:>12}\n", g.columns[j], format_number(low[j]), format_number(median(x[j])),
-                         format_number(high[j]), format_number(median(se[j])));
+                         format_number(high[j]), se[j].empty() ? std::string("-") : format_number(median(se[j])));
     }
   }
   return out;
 }
 
 std::string LocalFitSummary::report() const {
-  const std::size_t samples = groups.empty() || groups[0].records.empty() ? 0 : groups[0].records[0].window_samples;
   std::string out;
+  const std::string every = options.stride == 1 ? std::string("at every sample") : fmt::format("every {} samples", options.stride);
   if (options.forget)
-    out += fmt::format("Local fits (thesis chapter V): exponential forgetting, lambda = {} (a memory of about {} samples), an estimate {}\n",
-                       format_number(*options.forget), samples,
-                       options.stride == 1 ? std::string("at every sample") : fmt::format("every {} samples", options.stride));
+    out += fmt::format("Local fits (thesis chapter V): exponential forgetting, lambda = {}, an estimate {}\n", format_number(*options.forget),
+                       every);
   else
-    out += fmt::format("Local fits (thesis chapter V): windows of {} ({} samples), one {}\n", format_number(options.width), samples,
-                       options.stride == 1 ? std::string("at every sample") : fmt::format("every {} samples", options.stride));
+    out += fmt::format("Local fits (thesis chapter V): windows of {}, one {}\n", format_number(options.width), every);
   for (std::size_t g = 0; g < groups.size(); ++g) {
     std::string numbers;
     for (std::size_t e : groups[g].equations) numbers += (numbers.empty() ? "" : ", ") + std::to_string(e + 1);

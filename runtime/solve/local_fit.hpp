@@ -11,7 +11,8 @@
 // - Window k of a record covers the fit window's samples [k S, k S + W) (W = width / step,
 //   rounded; S the stride), every equation of the group; its row holds the estimates, standard
 //   errors, G (eq. 2-1.7), the rows n and the rank. A rank-deficient window carries no estimate and
-//   says so (rank < p); nothing is NaN but a standard error with n = p.
+//   says so (rank < p); nothing else is NaN but a standard error where n <= p (no residual
+//   degrees of freedom; with forgetting, n is the weighted count of rows and can be below p).
 // - Cost per window step O(S p^2): the factor is updated with the rows entering and downdated with
 //   those leaving. The windows are cut into pieces (about four turnovers of the window each) that
 //   start from a fresh factor, shared out over threads; each piece also computes the first window
@@ -19,8 +20,10 @@
 //   largest relative difference of the estimates is reported (drift), and a downdate that would
 //   lose accuracy (sliding_factor.hpp) is replaced by a fresh factor of that window and counted.
 // - With forgetting (lambda in (0, 1)), estimate k uses every sample up to k S, sample j weighted
-//   lambda^(kS - j) (the rows by sqrt of it); a piece starts log(1e-16)/log(lambda) samples before
-//   its first estimate, so that what it does not see weighs less than rounding.
+//   lambda^(kS - j) (the rows by sqrt of it); a piece starts log(1e-32)/log(lambda) samples before
+//   its first estimate, so that what it does not see weighs less than rounding in R.
+// - The pieces are laid out from the windows alone (never from the machine's cores), so the same
+//   record gives the same digits everywhere.
 // - Memory: the rows of a chunk of samples per thread, and the results (2p + 4 doubles a window).
 #pragma once
 
@@ -45,7 +48,7 @@ struct LocalFitOptions {
   int threads = 0;                 // 0: one per core, at most 8
   std::size_t piece_turnovers = 4; // a fresh factor every this many window lengths
   // Called on the calling thread as pieces finish: the record, its windows done and in all.
-  std::function<void(const std::string& record, std::size_t done, std::size_t total)> progress;
+  std::function<void(const std::string& what, std::size_t done, std::size_t total)> progress;
 };
 
 // Vectors whose resize leaves new elements uninitialised: the results of 10^6 windows are written
@@ -95,9 +98,12 @@ struct LocalFitSummary {
   std::string group_report(std::size_t group) const;  // its table for one group (the HTML report's)
 };
 
-// Before any work: a window longer than a record, or with fewer rows than a group's parameters
-// even where every sample gives a row (local_fit() checks again on the fit windows).
-std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local);
+// Before the global fit: a window longer than a record's samples (`options` given: than its fit
+// window, the samples the model's derivatives leave within from/to), or, for equations of the
+// derivative and integrated forms, with fewer rows than a group's parameters. A weak-form window's
+// rows are subdomains, known once they are chosen: local_fit() checks those.
+std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local,
+                                             const FitOptions* options = nullptr);
 
 std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                     const FitOptions& options, const LocalFitOptions& local);

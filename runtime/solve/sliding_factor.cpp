@@ -19,10 +19,10 @@ void SlidingFactor::clear() {
 
 namespace {
 
-// sqrt(a^2 + b^2) without hypot's cost; hypot only where the squares would overflow.
+// sqrt(a^2 + b^2) without hypot's cost; hypot where the squares would overflow or underflow.
 double norm2(double a, double b) {
   const double h = std::sqrt(a * a + b * b);
-  return std::isfinite(h) ? h : std::hypot(a, b);
+  return std::isfinite(h) && h >= DBL_MIN * 0x1p60 ? h : std::hypot(a, b);
 }
 
 // The rotation [c s; -s c] applied to the pairs (u_j, w_j): u <- c u + s w, w <- c w - s u.
@@ -86,9 +86,13 @@ bool SlidingFactor::remove(const double* x, double y) {
     zi = (zi - s_[static_cast<std::size_t>(i)] * zeta) / c_[static_cast<std::size_t>(i)];
     zeta = c_[static_cast<std::size_t>(i)] * zeta - s_[static_cast<std::size_t>(i)] * zi;
   }
+  // |zeta| > rho by rounding happens when the rows fit exactly (rho at rounding level): judged
+  // against the size of the rows' known side, ||b||^2 = ||z||^2 + rho^2, not rho alone.
   const double azeta = std::abs(zeta);
   if (azeta > rho_) {
-    rho_lost_ = rho_lost_ || azeta > rho_ * (1 + 1e-8);  // beyond rounding: rho is not known any more
+    double b2 = rho_ * rho_;
+    for (double v : z_) b2 += v * v;
+    rho_lost_ = rho_lost_ || azeta > rho_ + 64 * DBL_EPSILON * std::sqrt(b2);
     rho_ = 0;
   } else if (rho_ > 0) {
     rho_ *= std::sqrt(std::max(0.0, 1 - (azeta / rho_) * (azeta / rho_)));

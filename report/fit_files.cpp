@@ -10,6 +10,7 @@
 #include "ir/print.hpp"
 #include "ir/queries.hpp"
 #include "report/atomic_file.hpp"
+#include "report/csv_field.hpp"
 
 namespace sidc {
 namespace fs = std::filesystem;
@@ -21,12 +22,14 @@ namespace {
 bool write_residuals(std::ostream& out, const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
                      const FitSummary& s, std::optional<Diagnostic>& problem) {
   out << "group,equation,record,t,known,fitted,residual\n";
+  std::vector<std::string> paths;  // each record's path as a CSV field, made once
+  for (const auto& r : records) paths.push_back(csv_field(r.path));
   fmt::memory_buffer buffer;
   for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
     const auto d = for_each_residual_block(model, records, options, s, gi, [&](std::span<const ResidualRow> rows) {
       buffer.clear();
       for (const auto& r : rows)
-        fmt::format_to(std::back_inserter(buffer), "{},{},{},{},{},{},{}\n", gi + 1, r.equation + 1, records[r.record].path, r.time, r.known,
+        fmt::format_to(std::back_inserter(buffer), "{},{},{},{},{},{},{}\n", gi + 1, r.equation + 1, paths[r.record], r.time, r.known,
                        r.known - r.residual, r.residual);
       out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
       return static_cast<bool>(out);
@@ -35,18 +38,6 @@ bool write_residuals(std::ostream& out, const ir::Model& model, const std::vecto
     if (d || !out) return false;
   }
   return static_cast<bool>(out);
-}
-
-}  // namespace
-
-namespace {
-
-// A CSV field as RFC 4180 has it: quoted, its quotes doubled, when it holds a comma, a quote or a line end.
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
 }
 
 }  // namespace
@@ -71,8 +62,9 @@ bool write_local_csv(std::ostream& out, const LocalFitSummary& local) {
       else buffer.push_back(',');
     };
     const LocalRecordFit& front = local.groups.front().records[r];
+    const std::string path = records > 1 ? csv_field(front.path) : std::string();
     for (std::size_t k = first; k < last; ++k) {
-      if (records > 1) fmt::format_to(fmt::appender(buffer), "{},", csv_field(front.path));
+      if (records > 1) fmt::format_to(fmt::appender(buffer), "{},", path);
       fmt::format_to(fmt::appender(buffer), "{}", front.t_center[k]);
       for (const auto& g : local.groups) {
         const LocalRecordFit& fit = g.records[r];
@@ -307,7 +299,7 @@ std::string validation_csv(const FitValidation& v) {
   out += "\n";
   for (const auto& run : v.runs)
     for (std::size_t i = 0; i < run.simulation.time.size(); ++i) {
-      out += fmt::format("{},{}", run.record, run.simulation.time[i]);
+      out += fmt::format("{},{}", csv_field(run.record), run.simulation.time[i]);
       for (std::size_t j = 0; j < run.outputs.size(); ++j) out += fmt::format(",{},{},{}", run.recorded[j][i], run.simulated[j][i], run.error[j][i]);
       out += "\n";
     }

@@ -2,17 +2,9 @@
 
 #include <fmt/format.h>
 
+#include "report/csv_field.hpp"
+
 namespace sidc {
-namespace {
-
-std::string csv_field(const std::string& name) {
-  if (name.find_first_of(",\"\n") == std::string::npos) return name;
-  std::string out = "\"";
-  for (char c : name) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
-}  // namespace
 
 std::string bound_column(const ir::Model& model, const std::string& signal, const std::string& fallback) {
   for (const auto& d : model.data)

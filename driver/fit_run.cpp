@@ -173,7 +173,10 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
                                   refinement && refinement->improved() ? &refinement->values
                                   : iv && iv->is_solution_usable()      ? &fitted_estimate
                                                                         : nullptr,
-                                  refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables");
+                                  refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables",
+                                  out.progress ? [&out](const std::string& record, std::size_t done, std::size_t total) {
+                                    out.progress("validation: solving the fitted equations against " + record + " (samples)", done, total);
+                                  } : std::function<void(const std::string&, std::size_t, std::size_t)>());
     if (run.validation->failed_record) return failure(cli_diag::cannot_validate(run.validation->failed_path, *run.validation->failed_record));
     out.report(validation_report(*run.validation, records.size()));
   }

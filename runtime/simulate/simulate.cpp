@@ -633,6 +633,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
         }
       }
       record(row, s);
+      if (o.progress && (row % 65536 == 0 || row + 1 == n)) o.progress(row + 1, n);
     }
   } else {
     namespace odeint = boost::numeric::odeint;

@@ -64,6 +64,10 @@ struct SimulateOptions {
   // the jump each located switch of a guard or sign() adds (the switch time moves with q).
   bool sensitivities = false;
 
+  // Optional: told the output rows done and in all, every 65,536 rows and at the end of a
+  // completed run (a progress line for long runs; nothing computed depends on it).
+  std::function<void(std::size_t done, std::size_t total)> progress;
+
   bool is_valid(std::string* why) const;
 };
 

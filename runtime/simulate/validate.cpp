@@ -114,6 +114,8 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     v.estimate_iterations = estimate.iterations;
   }
   v.initial_state = named_state(form, o.initial);
+  if (options.progress)
+    o.progress = [&options, &record](std::size_t done, std::size_t total) { options.progress(record.path, done, total); };
   auto run = simulate(normalized, form, o);
   if (auto* d = std::get_if<Diagnostic>(&run)) return *d;
   v.simulation = std::get<SimulationSummary>(std::move(run));
@@ -214,7 +216,8 @@ std::string ValidationSummary::report(const std::string& method) const {
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples, InitialState initial_state, const std::vector<double>* refined,
-                           const std::string& refined_by) {
+                           const std::string& refined_by,
+                           const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress) {
   FitValidation v;
   if (refined) v.method += ", with the parameters " + refined_by;
   v.max_samples = max_samples;
@@ -231,6 +234,7 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   o.evaluation = evaluation;
   o.max_samples = max_samples;
   o.initial_state = initial_state;
+  o.progress = progress;
   for (std::size_t r = 0; r < records.size(); ++r) {
     auto run = validate(normalized, std::get<ExplicitForm>(form), parameters, *records[r], o);
     if (auto* d = std::get_if<Diagnostic>(&run)) {

@@ -19,6 +19,7 @@
 // cover the samples before the stop.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <variant>
@@ -73,6 +74,8 @@ struct ValidationOptions {
   // of every state derivative (the initial guess there comes from off-centre arcs): for a run whose
   // outputs are needed at every sample (the instruments of runtime/solve/instrumental_variables.hpp).
   bool from_first_sample = false;
+  // Optional: the free run's progress (SimulateOptions::progress), with the record's path.
+  std::function<void(const std::string& record, std::size_t done, std::size_t total)> progress;
 };
 
 struct OutputValidation {
@@ -143,7 +146,8 @@ struct FitValidation {
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples, InitialState initial_state = InitialState::estimate,
-                           const std::vector<double>* refined = nullptr, const std::string& refined_by = "refined by the output error");
+                           const std::vector<double>* refined = nullptr, const std::string& refined_by = "refined by the output error",
+                           const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress = {});
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
 // with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record (its initial

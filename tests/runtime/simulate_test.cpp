@@ -82,6 +82,25 @@ TEST(Simulate, Rk4ConvergesAtFourthOrder) {
   }
 }
 
+// The progress hook (a progress line for long free runs): called every 65,536 rows and once at the
+// end, done increasing to the number of rows, and the run itself unchanged by it.
+TEST(Simulate, ProgressIsToldEveryRowBlockAndAtTheEnd) {
+  const ir::Model m = normalized(kForced);
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {1, 1};
+  o.initial["y"] = {0, 0};
+  o.time = grid(0, 1400, 0.01);  // 140,001 rows: two blocks and the end
+  const auto plain = run(m, f, o);
+  std::vector<std::pair<std::size_t, std::size_t>> told;
+  o.progress = [&told](std::size_t done, std::size_t total) { told.emplace_back(done, total); };
+  const auto watched = run(m, f, o);
+  ASSERT_TRUE(watched.completed()) << watched.message;
+  EXPECT_EQ(watched.outputs, plain.outputs);
+  const std::vector<std::pair<std::size_t, std::size_t>> expected{{65537, 140001}, {131073, 140001}, {140001, 140001}};
+  EXPECT_EQ(told, expected);
+}
+
 TEST(Simulate, RecordedInputIsInterpolatedToFourthOrder) {
   // The same input as samples: the cubic interpolation's error is O(H^4) in the sample step H.
   const ir::Model m = normalized("input x\noutput y\nparam a, b\na*y'' + b*y = x\n");

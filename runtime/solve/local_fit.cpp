@@ -329,6 +329,23 @@ struct Slide {
 
 std::string format_number(double v) { return fmt::format("{:.6g}", v); }
 
+// The window's samples on `record` (at least one), or why WIDTH is longer than the `n` samples it
+// may cover.
+std::variant<std::size_t, Diagnostic> window_samples(const SampledRecord& record, double width, std::size_t n) {
+  const double samples = std::round(width / record.step);
+  if (!(samples <= static_cast<double>(n)))
+    return diag::local_window_too_long(record.path, width, samples, n, static_cast<double>(n) * record.step);
+  return static_cast<std::size_t>(std::max(samples, 1.0));
+}
+
+// A window of W samples holding at most `rows` rows (`per_sample` a sample on average) for p
+// parameters: why it is too short, the least width named in the hint.
+std::optional<Diagnostic> too_few_rows(const SampledRecord& record, double width, std::size_t W, std::size_t rows, std::size_t p,
+                                       double per_sample) {
+  if (rows >= p) return std::nullopt;
+  return diag::local_window_too_short(record.path, width, W, rows, p, std::ceil(static_cast<double>(p) / per_sample) * record.step);
+}
+
 }  // namespace
 
 std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::vector<SampledRecord>& records, const LocalFitOptions& local,
@@ -343,19 +360,16 @@ std::optional<Diagnostic> check_local_window(const ir::Model& model, const std::
       if (auto* d = std::get_if<Diagnostic>(&window)) return *d;
       n = std::get<FitWindow>(window).size();
     }
-    const double samples = std::round(local.width / record.step);
-    if (!(samples <= static_cast<double>(n)))
-      return diag::local_window_too_long(record.path, local.width, samples, n, static_cast<double>(n) * record.step);
+    auto samples = window_samples(record, local.width, n);
+    if (auto* d = std::get_if<Diagnostic>(&samples)) return *d;
+    const std::size_t W = std::get<std::size_t>(samples);
     const std::vector<SampledRecord> one{alone(record)};
     for (const auto& members : equation_groups(model)) {
       auto weak = is_weak_group(model, members);
       if (auto* d = std::get_if<Diagnostic>(&weak)) return *d;
       if (std::get<bool>(weak)) continue;  // rows are subdomains, known once chosen: local_fit() checks
       const std::size_t p = DesignBuilder(model, one, members).columns().size();
-      const auto W = static_cast<std::size_t>(std::max(samples, 1.0));
-      if (W * members.size() < p)
-        return diag::local_window_too_short(record.path, local.width, W, W * members.size(), p,
-                                            std::ceil(static_cast<double>(p) / static_cast<double>(members.size())) * record.step);
+      if (auto d = too_few_rows(record, local.width, W, W * members.size(), p, static_cast<double>(members.size()))) return d;
     }
   }
   return std::nullopt;
@@ -367,18 +381,25 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
   LocalFitSummary summary;
   summary.options = local;
   summary.threads = thread_count(options, local);
+  // Each record's operators (its arcs under savgol(auto)) and fit window, for every group.
+  std::vector<EvaluationOptions> evaluation;
+  std::vector<FitWindow> windows;
+  for (const auto& record : records) {
+    auto chosen = operators_for_record(options.evaluation, record, model);
+    if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+    evaluation.push_back(std::get<EvaluationOptions>(std::move(chosen)));
+    auto window = fit_window(record, model, evaluation.back(), options.from, options.to);
+    if (auto* d = std::get_if<Diagnostic>(&window)) return *d;
+    windows.push_back(std::get<FitWindow>(window));
+  }
   const auto all_groups = equation_groups(model);
   for (const auto& members : all_groups) {
     LocalGroupFit group;
     group.equations = members;
     for (std::size_t r = 0; r < records.size(); ++r) {
       RowSource rows(model, records[r], members);
-      auto chosen = operators_for_record(options.evaluation, records[r], model);
-      if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
-      rows.evaluation = std::get<EvaluationOptions>(std::move(chosen));
-      auto window = fit_window(records[r], model, rows.evaluation, options.from, options.to);
-      if (auto* d = std::get_if<Diagnostic>(&window)) return *d;
-      rows.window = std::get<FitWindow>(window);
+      rows.evaluation = evaluation[r];
+      rows.window = windows[r];
       rows.design = std::make_unique<DesignBuilder>(model, rows.one, members);
       if (r == 0) {
         group.columns = rows.design->column_names();
@@ -397,7 +418,6 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
       }
 
       const std::size_t n = rows.window.size(), p = static_cast<std::size_t>(rows.p());
-      const double step = records[r].step;
       LocalRecordFit fit;
       fit.path = records[r].path;
       Slide slide{rows, local, options.least_squares.rank_tolerance, 0, std::max<std::size_t>(local.stride, 1), 0, 1, fit, {}, {}, {}, {}, {}};
@@ -410,21 +430,18 @@ std::variant<LocalFitSummary, Diagnostic> local_fit(const ir::Model& model, cons
         slide.windows = (n - 1) / slide.S + 1;
         span = slide.W;
       } else {
-        const double samples = std::round(local.width / step);
-        const std::size_t rows_per_sample = rows.weak ? 0 : members.size();
-        if (!(samples <= static_cast<double>(n)))
-          return diag::local_window_too_long(records[r].path, local.width, samples, n, static_cast<double>(n) * step);
-        slide.W = static_cast<std::size_t>(std::max(samples, 1.0));
-        const std::size_t most = rows.weak ? 0 : slide.W * rows_per_sample;
-        std::size_t weak_most = 0;
-        if (rows.weak)
-          for (std::size_t s = 0; s + slide.W <= n; s += slide.W) weak_most = std::max(weak_most, rows.weak_first[s + slide.W] - rows.weak_first[s]);
-        if (std::max(most, weak_most) < p) {
-          const double per_sample = rows.weak ? static_cast<double>(rows.weak_first[n]) / static_cast<double>(n)
-                                              : static_cast<double>(rows_per_sample);
-          return diag::local_window_too_short(records[r].path, local.width, slide.W, std::max(most, weak_most), p,
-                                              std::ceil(static_cast<double>(p) / per_sample) * step);
+        auto samples = window_samples(records[r], local.width, n);
+        if (auto* d = std::get_if<Diagnostic>(&samples)) return *d;
+        slide.W = std::get<std::size_t>(samples);
+        // The most rows a window holds: every sample's equations, or the subdomains by centre.
+        std::size_t most = slide.W * members.size();
+        double per_sample = static_cast<double>(members.size());
+        if (rows.weak) {
+          most = 0;
+          for (std::size_t s = 0; s + slide.W <= n; s += slide.W) most = std::max(most, rows.weak_first[s + slide.W] - rows.weak_first[s]);
+          per_sample = static_cast<double>(rows.weak_first[n]) / static_cast<double>(n);
         }
+        if (auto d = too_few_rows(records[r], local.width, slide.W, most, p, per_sample)) return *d;
         fit.window_samples = slide.W;
         slide.windows = (n - slide.W) / slide.S + 1;
         span = slide.W;

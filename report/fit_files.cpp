@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 #include <filesystem>
 #include <fmt/format.h>
 
@@ -79,23 +78,15 @@ bool write_local_csv(std::ostream& out, const LocalFitSummary& local) {
       buffer.push_back('\n');
     }
   };
-  // Formatting 10^6 windows of 20 parameters is seconds of work: chunks are formatted on every
-  // core, a round at a time, and written in order.
+  // Written a chunk of windows at a time (a 10^6-window file is hundreds of MB). Formatting the
+  // chunks on several cores was tried: the write and the sync, not the formatting, set the time.
   constexpr std::size_t kChunk = 4096;
-  const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
-  std::vector<fmt::memory_buffer> buffers(threads);
+  fmt::memory_buffer buffer;
   for (std::size_t r = 0; r < records; ++r) {
     const std::size_t windows = local.groups.front().records[r].windows();
-    for (std::size_t round = 0; round < windows; round += kChunk * threads) {
-      std::vector<std::thread> running;
-      std::size_t used = 0;
-      for (std::size_t t = 0; t < threads && round + t * kChunk < windows; ++t, ++used) {
-        const std::size_t first = round + t * kChunk, last = std::min(windows, first + kChunk);
-        if (t + 1 < threads && last < windows) running.emplace_back([&, first, last, t] { format(r, first, last, buffers[t]); });
-        else format(r, first, last, buffers[t]);
-      }
-      for (auto& thread : running) thread.join();
-      for (std::size_t t = 0; t < used; ++t) out.write(buffers[t].data(), static_cast<std::streamsize>(buffers[t].size()));
+    for (std::size_t first = 0; first < windows; first += kChunk) {
+      format(r, first, std::min(windows, first + kChunk), buffer);
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
       if (!out) return false;
     }
   }

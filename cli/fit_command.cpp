@@ -16,6 +16,7 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/form_options.hpp"
+#include "cli/number_check.hpp"
 #include "cli/output_check.hpp"
 #include "cli/progress_line.hpp"
 #include "cli/record_options.hpp"
@@ -151,21 +152,6 @@ int run_fit(const FitArguments& a) {
   }
   std::cout << comparison_table(compare_models(std::move(totals)));
   return status;
-}
-
-// A number option's check, with `message` (what it must be) for anything else, text or NaN.
-CLI::Validator number_check(const std::string& name, bool (*holds)(double), const std::string& message) {
-  return CLI::Validator(
-      [holds, message](std::string& text) {
-        try {
-          std::size_t used = 0;
-          const double v = std::stod(text, &used);
-          if (used == text.size() && holds(v)) return std::string();
-        } catch (...) {
-        }
-        return message;
-      },
-      name);
 }
 
 }  // namespace

@@ -1,21 +1,14 @@
 #include "cli/record_options.hpp"
 
-#include <charconv>
 #include <cmath>
+
+#include "cli/number_check.hpp"
 
 namespace sidc {
 namespace {
 
-// CLI11's own range check prints the whole range of a double; say it plainly.
-const CLI::Validator positive = CLI::Validator(
-    [](std::string& value) -> std::string {
-      double x = 0;
-      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), x);
-      if (ec != std::errc() || end != value.data() + value.size() || !(x > 0) || !std::isfinite(x))
-        return "`" + value + "` is not a positive number";
-      return {};
-    },
-    "POSITIVE");
+const CLI::Validator positive =
+    number_check("POSITIVE", [](double x) { return x > 0 && std::isfinite(x); }, "`{}` is not a positive number");
 
 }  // namespace
 

@@ -244,10 +244,11 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
       const std::size_t p = group.columns.size();
       for (std::size_t r = 0; r < group.records.size(); ++r) {
         const LocalRecordFit& fit = group.records[r];
+        const std::vector<double> t(fit.t_center.begin(), fit.t_center.end());  // every parameter's abscissa
+        const std::string on = c.records.size() > 1 ? what + ", " + record_name(fit.path) : what;
         for (std::size_t j = 0; j < p; ++j) {
-          std::vector<double> x(fit.windows()), se(fit.windows()), t(fit.t_center.begin(), fit.t_center.end());
+          std::vector<double> x(fit.windows()), se(fit.windows());
           for (std::size_t k = 0; k < fit.windows(); ++k) x[k] = fit.estimates[k * p + j], se[k] = fit.standard_errors[k * p + j];
-          const std::string on = c.records.size() > 1 ? what + ", " + record_name(fit.path) : what;
           figures.push_back({local_estimate_figure(group.columns[j], suffix(r), time, on, t, x, se), static_cast<int>(g)});
         }
       }

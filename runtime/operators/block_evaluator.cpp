@@ -193,7 +193,9 @@ std::variant<BlockEvaluator::Values, Diagnostic> BlockEvaluator::compute_factor(
     case FactorKind::integral: {
       const auto found = whole_.integrals.find(name_of(f));
       if (found == whole_.integrals.end()) throw std::logic_error("an integral was not prepared");
-      return slice(found->second, r);
+      const std::size_t from = whole_.integrals_first;
+      if (r.first < from || r.last > from + found->second.size()) throw std::logic_error("a block outside the integrals' stretch");
+      return slice(found->second, Range{r.first - from, r.last - from});
     }
     case FactorKind::function: {
       auto argument = sum(*f.argument, r);

@@ -13,9 +13,10 @@
 //   k >= 3, which are repeated products here (y^3 = y^2 * y) where Evaluator calls std::pow:
 //   they agree to a few units in the last place.
 // - Values that depend on the whole window (integrals from t0, eqs. 2-1.4 and 2-2.5; initial
-//   values y(t0)) are evaluated once by an Evaluator over the whole record before the blocks
-//   (prepare()) and sliced: identical to the dense path, at the cost of 8 bytes per sample for each
-//   distinct integral (none in derivative-form models).
+//   values y(t0)) are given: evaluated once by an Evaluator over the whole record before the blocks
+//   (prepare_whole_window_values) and sliced, identical to the dense path at the cost of 8 bytes per
+//   sample for each distinct integral; or carried stretch by stretch (running_integrals.hpp), in
+//   memory that does not grow with the record.
 // - A value that is not finite is reported with the index of the term that made it and the sample,
 //   so that the caller can name the same term and time the dense path names.
 #pragma once
@@ -41,8 +42,12 @@ struct NonFiniteValue {
 };
 
 // Whole-window values shared by the blocks (read-only once prepared, so several threads can share).
+// The integrals cover record samples [integrals_first, integrals_first + length): the whole record
+// when prepared at once (NaN outside the window), one stretch of the window when carried
+// (running_integrals.hpp); a block outside what they cover is a bug (std::logic_error).
 struct WholeWindowValues {
-  std::map<std::string, std::vector<double>> integrals;  // by printed factor, whole record (NaN outside the window)
+  std::map<std::string, std::vector<double>> integrals;  // by printed factor
+  std::size_t integrals_first = 0;                        // the record sample of each vector's [0]
   std::map<std::string, double> initial_values;           // by printed factor
 };
 

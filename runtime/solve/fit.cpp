@@ -22,6 +22,7 @@
 #include "ir/traversal.hpp"
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/operators/operator_choice.hpp"
+#include "runtime/operators/running_integrals.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 #include "runtime/solve/weak_design.hpp"
 
@@ -85,7 +86,9 @@ struct StreamPlan {
   const FitOptions& options;
   const std::vector<EvaluationOptions>& evaluation;  // per record: its arcs under savgol(auto)
   const DesignBuilder& design;
-  std::vector<WholeWindowValues> whole;  // per record
+  std::vector<WholeWindowValues> whole;  // per record: all its integrals, or (carried) its initial values only
+  std::vector<char> carried;             // per record: integrals carried stretch by stretch (running_integrals.hpp)
+  std::vector<const ir::Sum*> sums;      // every sum the rows evaluate: the design's, the guards', the weights'
   std::vector<std::string> guard_texts;  // the group's guards, in count_regions' order
   std::vector<ir::Sum> guard_sums;
 };
@@ -146,13 +149,14 @@ double thread_cpu_seconds() {
 }
 
 // Window rows [begin, end) of record r for equation e, block by block: evaluated into the
-// accumulator's own work area, checked, counted by region when asked, and folded.
-void stream_rows(const StreamPlan& plan, StreamWorker& worker, std::size_t r, std::size_t e, std::size_t begin, std::size_t end,
-                 bool count_regions) {
+// accumulator's own work area, checked, counted by region when asked, and folded. `whole` holds the
+// integrals on at least these rows.
+void stream_rows(const StreamPlan& plan, const WholeWindowValues& whole, StreamWorker& worker, std::size_t r, std::size_t e,
+                 std::size_t begin, std::size_t end, bool count_regions) {
   const SampledRecord& record = plan.records[r];
   const FitWindow& w = plan.windows[r];
   const auto p = static_cast<Eigen::Index>(plan.design.columns().size());
-  BlockEvaluator evaluator(record, plan.evaluation[r], w, plan.whole[r]);
+  BlockEvaluator evaluator(record, plan.evaluation[r], w, whole);
   BlockValues values(evaluator, record, w, &worker.problem), guard_values(evaluator, record, w, &worker.guard_problem);
   const std::size_t block_rows = std::max<std::size_t>(plan.options.stream_block_rows, 1);
   std::vector<double> guards(count_regions ? plan.guard_sums.size() * block_rows : 0);
@@ -205,16 +209,30 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
                                        const std::vector<FitWindow>& windows, const FitOptions& options,
                                        const std::vector<EvaluationOptions>& evaluation, const DesignBuilder& design,
                                        std::size_t total_rows, GroupFit& g) {
-  StreamPlan plan{model, records, windows, options, evaluation, design, {}, {}, {}};
+  StreamPlan plan{model, records, windows, options, evaluation, design, {}, {}, {}, {}, {}};
   for (const auto& [text, f] : guards_of(model, g.equations)) {
     plan.guard_texts.push_back(text);
     plan.guard_sums.push_back(ir::factor(f));
   }
-  std::vector<const ir::Sum*> sums = design.sums();
-  for (const auto& s : plan.guard_sums) sums.push_back(&s);
-  if (model.weights) sums.push_back(&model.weights->value);
+  plan.sums = design.sums();
+  for (const auto& s : plan.guard_sums) plan.sums.push_back(&s);
+  if (model.weights) plan.sums.push_back(&model.weights->value);
+  // Integrals are carried stretch by stretch where they can be (memory that does not grow with the
+  // record), and prepared over the whole record at once where they cannot.
+  std::vector<std::optional<RunningIntegrals>> fresh;  // per carried record: its integrals found, nothing carried yet
   for (std::size_t r = 0; r < records.size(); ++r) {
-    auto whole = prepare_whole_window_values(records[r], model, evaluation[r], windows[r], sums);
+    plan.carried.push_back(RunningIntegrals::carries(model, evaluation[r], windows[r], plan.sums));
+    fresh.emplace_back();
+    if (plan.carried[r]) {
+      auto running = RunningIntegrals::start(records[r], model, evaluation[r], windows[r], plan.sums);
+      if (auto* d = std::get_if<Diagnostic>(&running)) return *d;
+      fresh[r] = std::get<RunningIntegrals>(std::move(running));
+      WholeWindowValues initial;
+      initial.initial_values = fresh[r]->values().initial_values;
+      plan.whole.push_back(std::move(initial));
+      continue;
+    }
+    auto whole = prepare_whole_window_values(records[r], model, evaluation[r], windows[r], plan.sums);
     if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
     plan.whole.push_back(std::get<WholeWindowValues>(std::move(whole)));
   }
@@ -241,21 +259,36 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   for (int k = 0; k < threads; ++k) workers.emplace_back(p);
   const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
   int threads_used = 1;
+  // Window rows [begin, end) of record r in contiguous parts of whole blocks, one per thread; a
+  // short stretch stays on one thread.
+  const auto fold_parts = [&](const WholeWindowValues& whole, std::size_t r, std::size_t e, std::size_t begin, std::size_t end) {
+    const std::size_t blocks = (end - begin + block_rows - 1) / block_rows;
+    const std::size_t parts = std::min<std::size_t>(static_cast<std::size_t>(threads), std::max<std::size_t>(blocks / 4, 1));
+    threads_used = std::max(threads_used, static_cast<int>(parts));
+    const bool count = e == g.equations.front();
+    const auto bound = [&](std::size_t k) { return std::min(end, begin + blocks * k / parts * block_rows); };
+    std::vector<std::thread> running;
+    for (std::size_t k = 1; k < parts; ++k)
+      running.emplace_back([&, k] { stream_rows(plan, whole, workers[k], r, e, bound(k), bound(k + 1), count); });
+    stream_rows(plan, whole, workers[0], r, e, begin, bound(1), count);
+    for (auto& t : running) t.join();
+  };
+  // Integrals are carried over stretches of this many rows, each stretch's integrands evaluated
+  // and its rows folded on every thread.
+  const std::size_t stretch = std::max<std::size_t>(options.stream_stretch_rows, 4);
   for (std::size_t r = 0; r < records.size(); ++r) {
     for (std::size_t e : g.equations) {
       const std::size_t n = windows[r].size();
-      // Contiguous parts of whole blocks, one per thread; a short window stays on one thread.
-      const std::size_t blocks = (n + block_rows - 1) / block_rows;
-      const std::size_t parts = std::min<std::size_t>(static_cast<std::size_t>(threads), std::max<std::size_t>(blocks / 4, 1));
-      threads_used = std::max(threads_used, static_cast<int>(parts));
-      const bool count = e == g.equations.front();
-      std::vector<std::thread> running;
-      for (std::size_t k = 1; k < parts; ++k) {
-        const std::size_t begin = std::min(n, blocks * k / parts * block_rows), end = std::min(n, blocks * (k + 1) / parts * block_rows);
-        running.emplace_back([&, k, begin, end, r, e] { stream_rows(plan, workers[k], r, e, begin, end, count); });
+      if (!plan.carried[r]) {
+        fold_parts(plan.whole[r], r, e, 0, n);
+      } else {
+        RunningIntegrals running = *fresh[r];  // from t0 again for each equation
+        for (std::size_t begin = 0; begin < n; begin += stretch) {
+          const std::size_t end = std::min(n, begin + stretch);
+          if (auto problem = running.advance(end, threads, block_rows)) return problem;
+          fold_parts(running.values(), r, e, begin, end);
+        }
       }
-      stream_rows(plan, workers[0], r, e, 0, std::min(n, blocks / parts * block_rows), count);
-      for (auto& t : running) t.join();
       // The dense path's first problem: the smallest key over the parts of this record and equation.
       Problem first;
       for (auto& w : workers)
@@ -510,22 +543,41 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
     // of the whole record) of the first rows do not depend on where the window ends.
     if (w.size() > remaining) w.last = w.first + remaining - 1;
     remaining -= w.size();
-    auto whole = prepare_whole_window_values(records[r], model, evaluation, w, design.sums());
-    if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
-    BlockEvaluator evaluator(records[r], evaluation, w, std::get<WholeWindowValues>(whole));
-    BlockValues values(evaluator, records[r], w, nullptr);
+    // The integrals as the fit had them: carried stretch by stretch, or the whole window at once.
+    const std::vector<const ir::Sum*> sums = design.sums();
+    const bool carried = RunningIntegrals::carries(model, evaluation, w, sums);
+    std::optional<RunningIntegrals> fresh;
+    WholeWindowValues whole;
+    if (carried) {
+      auto running = RunningIntegrals::start(records[r], model, evaluation, w, sums);
+      if (auto* d = std::get_if<Diagnostic>(&running)) return *d;
+      fresh = std::get<RunningIntegrals>(std::move(running));
+    } else {
+      auto prepared = prepare_whole_window_values(records[r], model, evaluation, w, sums);
+      if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
+      whole = std::get<WholeWindowValues>(std::move(prepared));
+    }
+    const std::size_t stretch = carried ? std::max<std::size_t>(options.stream_stretch_rows, 4) : w.size();
     for (std::size_t e : g.equations) {
-      for (std::size_t start = 0; start < w.size(); start += block_rows) {
-        const std::size_t m = std::min(block_rows, w.size() - start);
-        const auto count = static_cast<Eigen::Index>(m);
-        evaluator.start_block(w.first + start, w.first + start + m);
-        A.setZero();
-        if (auto problem = design.equation_rows(r, e, values, {A.topRows(count), b.head(count)})) return problem;
-        const Eigen::VectorXd residuals = TriangularAccumulator::residuals_of(A.topRows(count), b.head(count), g.summary);
-        block.clear();
-        for (std::size_t i = 0; i < m; ++i)
-          block.push_back({e, r, records[r].time[w.first + start + i], b(static_cast<Eigen::Index>(i)), residuals(static_cast<Eigen::Index>(i))});
-        if (!rows(block)) return std::nullopt;
+      std::optional<RunningIntegrals> running = fresh;
+      for (std::size_t begin = 0; begin < w.size(); begin += stretch) {
+        const std::size_t end = std::min(w.size(), begin + stretch);
+        if (running)
+          if (auto problem = running->advance(end, 1, block_rows)) return problem;
+        BlockEvaluator evaluator(records[r], evaluation, w, running ? running->values() : whole);
+        BlockValues values(evaluator, records[r], w, nullptr);
+        for (std::size_t start = begin; start < end; start += block_rows) {
+          const std::size_t m = std::min(block_rows, end - start);
+          const auto count = static_cast<Eigen::Index>(m);
+          evaluator.start_block(w.first + start, w.first + start + m);
+          A.setZero();
+          if (auto problem = design.equation_rows(r, e, values, {A.topRows(count), b.head(count)})) return problem;
+          const Eigen::VectorXd residuals = TriangularAccumulator::residuals_of(A.topRows(count), b.head(count), g.summary);
+          block.clear();
+          for (std::size_t i = 0; i < m; ++i)
+            block.push_back({e, r, records[r].time[w.first + start + i], b(static_cast<Eigen::Index>(i)), residuals(static_cast<Eigen::Index>(i))});
+          if (!rows(block)) return std::nullopt;
+        }
       }
     }
   }

@@ -48,6 +48,9 @@ struct FitOptions {
   std::size_t stream_above_entries = 8'000'000;
   std::size_t stream_block_rows = 2048;  // rows evaluated and folded at a time
   int stream_threads = 0;                // threads folding row blocks; 0 = one per core, at most 8
+  // Integrals from t0 are carried from stretch to stretch of this many rows (at least 4), so a
+  // streamed integrated form holds one stretch of each integral (runtime/operators/running_integrals.hpp).
+  std::size_t stream_stretch_rows = std::size_t{1} << 17;
   bool is_valid(std::string* why) const;
 };
 

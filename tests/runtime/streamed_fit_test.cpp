@@ -53,6 +53,7 @@ FitOptions streamed(FitOptions o, std::size_t block_rows = 7, int threads = 2) {
   o.stream_above_entries = 0;
   o.stream_block_rows = block_rows;
   o.stream_threads = threads;
+  o.stream_stretch_rows = 3 * block_rows + 1;  // integrals carried over many stretches, each a few blocks, not whole
   return o;
 }
 

@@ -19,6 +19,7 @@
 #include "ir/print.hpp"
 #include "runtime/select/forward_regression.hpp"
 #include "runtime/select/sequential_threshold.hpp"
+#include "runtime/select/streamed_rows.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 #include "runtime/solve/weak_design.hpp"
 #include "runtime/not_a_number.hpp"
@@ -254,7 +255,27 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
     std::vector<TriangularAccumulator> blocks(static_cast<std::size_t>(fine), TriangularAccumulator(p));
     auto weak = is_weak_group(model, members);
     if (auto* d = std::get_if<Diagnostic>(&weak)) return *d;
+    // Per column: the least line share over the records and equations where its operation occurs.
+    const auto note_shares = [&](std::size_t k, const std::vector<double>& share) {
+      const int integrations = model.equations[members[k]].integrations;
+      for (std::size_t c = 0; c < share.size(); ++c) {
+        if (std::isnan(share[c])) continue;
+        if (std::isnan(drift_share[c]) || share[c] < drift_share[c]) drift_share[c] = share[c], drift_degree[c] = integrations + 1;
+        if (integrations > 0) integrated[c] = 1;
+      }
+    };
     for (std::size_t r = 0; r < records.size(); ++r) {
+      // A design larger than the fit keeps whole is streamed, as fit streams it (streamed_rows.hpp);
+      // a problem there sends the record to the whole rows below, which word it.
+      if (!std::get<bool>(weak) && windows[r].size() * members.size() * static_cast<std::size_t>(p) > options.fit.stream_above_entries) {
+        std::vector<std::vector<double>> shares;
+        auto streamed = stream_record_rows(model, records, r, evaluation[r], windows[r], design, members, options.fit, blocks, shares);
+        if (auto* d = std::get_if<Diagnostic>(&streamed)) return *d;
+        if (std::get<StreamedRows>(streamed) == StreamedRows::folded) {
+          for (std::size_t k = 0; k < shares.size(); ++k) note_shares(k, shares[k]);
+          continue;
+        }
+      }
       Evaluator evaluator(records[r], model, evaluation[r], windows[r]);
       std::vector<double> expression;  // eq. 2-1.6 as sidc fit applies it
       if (model.weights) {
@@ -279,16 +300,9 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
         weights = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(W * E));
         if (auto problem = design.window_rows(r, evaluator, expression, A, b, weights, 0)) return *problem;
         // The drift test reads sample rows; the weak form's subdomain rows do not drift.
-        for (std::size_t k = 0; k < E; ++k) {
-          const int integrations = model.equations[members[k]].integrations;
-          const std::vector<double> share =
-              operation_line_share(A.middleRows(static_cast<Eigen::Index>(k * W), static_cast<Eigen::Index>(W)), integrations);
-          for (std::size_t c = 0; c < share.size(); ++c) {
-            if (std::isnan(share[c])) continue;
-            if (std::isnan(drift_share[c]) || share[c] < drift_share[c]) drift_share[c] = share[c], drift_degree[c] = integrations + 1;
-            if (integrations > 0) integrated[c] = 1;
-          }
-        }
+        for (std::size_t k = 0; k < E; ++k)
+          note_shares(k, operation_line_share(A.middleRows(static_cast<Eigen::Index>(k * W), static_cast<Eigen::Index>(W)),
+                                              model.equations[members[k]].integrations));
       }
       const bool weighted = !records[r].weights.empty() || !expression.empty();
       for (int block = 0; block < fine; ++block) {

@@ -69,4 +69,80 @@ std::vector<double> operation_line_share(const Eigen::Ref<const Eigen::MatrixXd>
   return polynomial_energy_share(d, 1);
 }
 
+LineShareSums::LineShareSums(std::size_t rows, Eigen::Index p, int integrations)
+    : n_(rows > static_cast<std::size_t>(integrations) ? rows - static_cast<std::size_t>(integrations) : 0),
+      integrations_(integrations),
+      head_(0, p),
+      tail_(0, p),
+      cross_(Eigen::MatrixXd::Zero(2, p)),
+      squares_(Eigen::VectorXd::Zero(p)) {}
+
+// The last `k` rows of [a; b].
+static Eigen::MatrixXd last_rows(const Eigen::MatrixXd& a, const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::Index k) {
+  Eigen::MatrixXd both(a.rows() + b.rows(), a.cols());
+  both << a, b;
+  k = std::min(k, both.rows());
+  return both.bottomRows(k);
+}
+
+void LineShareSums::accumulate(std::size_t first_level0, const Eigen::Ref<const Eigen::MatrixXd>& rows) {
+  Eigen::MatrixXd d = rows;
+  for (int i = 0; i < integrations_ && d.rows() > 0; ++i) d = (d.bottomRows(d.rows() - 1) - d.topRows(d.rows() - 1)).eval();
+  if (d.rows() == 0) return;
+  // polynomial_energy_share's abscissa of each differenced row.
+  Eigen::VectorXd x(d.rows());
+  for (Eigen::Index i = 0; i < d.rows(); ++i) {
+    const auto k = static_cast<double>(first_level0 + static_cast<std::size_t>(i));
+    x(i) = n_ > 1 ? 2.0 * k / static_cast<double>(n_ - 1) - 1.0 : 0.0;
+  }
+  gram_[0] += static_cast<double>(d.rows()), gram_[1] += x.sum(), gram_[2] += x.squaredNorm();
+  cross_.row(0) += d.colwise().sum();
+  cross_.row(1) += x.transpose() * d;
+  squares_ += d.colwise().squaredNorm().transpose();
+}
+
+void LineShareSums::add(std::size_t first, const Eigen::Ref<const Eigen::MatrixXd>& block) {
+  if (count_ == 0) first_ = first;
+  const auto I = static_cast<Eigen::Index>(integrations_);
+  Eigen::MatrixXd stacked(tail_.rows() + block.rows(), block.cols());
+  stacked << tail_, block;
+  accumulate(first_ + count_ - static_cast<std::size_t>(tail_.rows()), stacked);
+  if (head_.rows() < I) head_ = Eigen::MatrixXd(stacked.topRows(std::min(I, static_cast<Eigen::Index>(count_) + block.rows())));
+  tail_ = last_rows(tail_, block, I);
+  count_ += static_cast<std::size_t>(block.rows());
+}
+
+void LineShareSums::join(const LineShareSums& next) {
+  if (next.count_ == 0) return;
+  if (count_ == 0) {
+    *this = next;
+    return;
+  }
+  const auto I = static_cast<Eigen::Index>(integrations_);
+  Eigen::MatrixXd stacked(tail_.rows() + next.head_.rows(), tail_.cols());
+  stacked << tail_, next.head_;
+  accumulate(first_ + count_ - static_cast<std::size_t>(tail_.rows()), stacked);  // the differences across the join
+  for (int k = 0; k < 3; ++k) gram_[k] += next.gram_[k];
+  cross_ += next.cross_;
+  squares_ += next.squares_;
+  if (head_.rows() < I) head_ = Eigen::MatrixXd(stacked.topRows(std::min(I, stacked.rows())));
+  tail_ = last_rows(tail_, next.tail_, I);
+  count_ += next.count_;
+}
+
+std::vector<double> LineShareSums::shares() const {
+  std::vector<double> share(static_cast<std::size_t>(squares_.size()), std::numeric_limits<double>::quiet_NaN());
+  if (n_ == 0) return share;
+  // The projection onto span(1, x): c^T G^-1 c; with one row the basis is the constant alone.
+  const double det = gram_[0] * gram_[2] - gram_[1] * gram_[1];
+  for (Eigen::Index c = 0; c < squares_.size(); ++c) {
+    const double total = squares_(c);
+    if (!(total > 0)) continue;  // the operation does not occur here (or is not finite)
+    const double s0 = cross_(0, c), s1 = cross_(1, c);
+    const double explained = n_ > 1 ? (gram_[2] * s0 * s0 - 2 * gram_[1] * s0 * s1 + gram_[0] * s1 * s1) / det : s0 * s0 / gram_[0];
+    share[static_cast<std::size_t>(c)] = std::clamp(explained / total, 0.0, 1.0);
+  }
+  return share;
+}
+
 }  // namespace sidc

@@ -55,4 +55,33 @@ ElbowResult relative_g_elbow(const std::vector<double>& G, double share = kElbow
 std::vector<double> polynomial_energy_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int degree);
 std::vector<double> operation_line_share(const Eigen::Ref<const Eigen::MatrixXd>& values, int integrations);
 
+// operation_line_share over rows that arrive piece by piece, on one thread or several (the
+// streamed selection): the sums of the line's normal equations per piece (the Legendre basis of
+// degree 1 is well conditioned: a 2 x 2 Gram matrix near diag(n, n/3)), joined in row order; the
+// differences that straddle two pieces are formed at the join from the last and first I rows
+// each piece keeps. The differences are operation_line_share's, value for value; the shares agree
+// with it to rounding (the projection's energy over the total, where it takes 1 - RSS / total).
+class LineShareSums {
+ public:
+  // `rows`: the equation's rows in all (W, before differencing), `p` columns, I = `integrations`.
+  LineShareSums(std::size_t rows, Eigen::Index p, int integrations);
+  // Rows [first, first + block.rows()) of the equation; the first call names where this piece
+  // starts, and each later call continues where the last ended.
+  void add(std::size_t first, const Eigen::Ref<const Eigen::MatrixXd>& block);
+  // Appends the piece `next`, whose rows start where this one's end.
+  void join(const LineShareSums& next);
+  std::vector<double> shares() const;
+
+ private:
+  void accumulate(std::size_t first_level0, const Eigen::Ref<const Eigen::MatrixXd>& rows);  // the I-th differences of `rows`
+
+  std::size_t n_;  // differenced rows in all
+  int integrations_;
+  std::size_t first_ = 0, count_ = 0;  // this piece's rows
+  Eigen::MatrixXd head_, tail_;        // its first and last min(I, count) rows
+  double gram_[3] = {0, 0, 0};         // sum 1, sum x, sum x^2
+  Eigen::MatrixXd cross_;              // 2 x p: sum v, sum x v
+  Eigen::VectorXd squares_;            // p: sum v^2
+};
+
 }  // namespace sidc

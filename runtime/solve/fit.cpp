@@ -199,11 +199,6 @@ void stream_rows(const StreamPlan& plan, const WholeWindowValues& whole, StreamW
   }
 }
 
-int stream_thread_count(const FitOptions& options) {
-  if (options.stream_threads > 0) return options.stream_threads;
-  return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
-}
-
 // The streamed path for one group (FitOptions::stream_above_entries).
 std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector<SampledRecord>& records,
                                        const std::vector<FitWindow>& windows, const FitOptions& options,
@@ -389,6 +384,11 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
 }
 
 }  // namespace
+
+int stream_thread_count(const FitOptions& options) {
+  if (options.stream_threads > 0) return options.stream_threads;
+  return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+}
 
 bool FitOptions::is_valid(std::string* why) const {
   if (from && to && *from > *to) {

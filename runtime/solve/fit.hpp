@@ -54,6 +54,9 @@ struct FitOptions {
   bool is_valid(std::string* why) const;
 };
 
+// The threads a streamed pass uses: FitOptions::stream_threads, or one per core (at most 8).
+int stream_thread_count(const FitOptions& options);
+
 // The rows one record gave to one group.
 struct RecordRows {
   std::string path;

@@ -58,7 +58,7 @@ void expect_carried_equals_whole(const ir::Model& m, const SampledRecord& r, con
   ASSERT_GE(whole.integrals.size(), 4u);
   for (const std::size_t stretch : {std::size_t{4}, std::size_t{5}, std::size_t{7}, std::size_t{64}, w.size()}) {
     for (const int threads : {1, 3}) {
-      SCOPED_TRACE(testing::Message() << "stretch " << stretch << ", threads " << threads);
+      SCOPED_TRACE(::testing::Message() << "stretch " << stretch << ", threads " << threads);
       auto started = RunningIntegrals::start(r, m, options, w, sums);
       ASSERT_TRUE(std::holds_alternative<RunningIntegrals>(started));
       RunningIntegrals running = std::get<RunningIntegrals>(std::move(started));

@@ -1,0 +1,167 @@
+// select's rows of one record, streamed (see streamed_rows.hpp).
+#include "runtime/select/streamed_rows.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <thread>
+
+#include "ir/traversal.hpp"
+#include "runtime/operators/block_evaluator.hpp"
+#include "runtime/operators/running_integrals.hpp"
+#include "runtime/select/size_rule.hpp"
+
+namespace sidc {
+namespace {
+
+// A block's values; any problem (structural, or a value that is not finite) only marks the pass,
+// which then gives the record back to the whole rows.
+class MarkingValues final : public DesignValues {
+ public:
+  MarkingValues(BlockEvaluator& evaluator, bool& failed) : evaluator_(evaluator), failed_(failed) {}
+  std::optional<Diagnostic> evaluate(const ir::Sum& sum, std::size_t, const std::string&, std::span<double> out) override {
+    std::optional<NonFiniteValue> bad;
+    auto status = evaluator_.evaluate(sum, out, &bad);
+    if (auto* d = std::get_if<Diagnostic>(&status)) {
+      failed_ = true;
+      return std::move(*d);
+    }
+    if (bad) {
+      failed_ = true;
+      return Diagnostic{};
+    }
+    return std::nullopt;
+  }
+
+ private:
+  BlockEvaluator& evaluator_;
+  bool& failed_;
+};
+
+// One thread's share: its own triangles (one per time block) and, per stretch, its piece's line sums.
+struct Worker {
+  std::vector<TriangularAccumulator> blocks;
+  std::vector<LineShareSums> lines;
+  bool failed = false;
+};
+
+}  // namespace
+
+std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model, const std::vector<SampledRecord>& records,
+                                                          std::size_t r, const EvaluationOptions& evaluation, FitWindow window,
+                                                          const DesignBuilder& design, const std::vector<std::size_t>& members,
+                                                          const FitOptions& options, std::vector<TriangularAccumulator>& blocks,
+                                                          std::vector<std::vector<double>>& shares) {
+  const SampledRecord& record = records[r];
+  const auto p = static_cast<Eigen::Index>(design.columns().size());
+  const std::size_t W = window.size(), E = members.size(), F = blocks.size();
+  std::vector<const ir::Sum*> sums = design.sums();
+  if (model.weights) sums.push_back(&model.weights->value);
+
+  // Integrals carried, or (where they cannot be) the whole window's prepared at once.
+  std::optional<RunningIntegrals> running;
+  WholeWindowValues whole;
+  if (RunningIntegrals::carries(model, evaluation, window, sums)) {
+    auto started = RunningIntegrals::start(record, model, evaluation, window, sums);
+    if (auto* d = std::get_if<Diagnostic>(&started)) return *d;
+    running = std::get<RunningIntegrals>(std::move(started));
+  } else {
+    auto prepared = prepare_whole_window_values(record, model, evaluation, window, sums);
+    if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
+    whole = std::get<WholeWindowValues>(std::move(prepared));
+  }
+
+  const int threads = stream_thread_count(options);
+  const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
+  std::vector<Worker> workers(static_cast<std::size_t>(threads));
+  for (auto& w : workers) w.blocks.assign(F, TriangularAccumulator(static_cast<int>(p)));
+  std::vector<LineShareSums> lines;
+  for (std::size_t k = 0; k < E; ++k) lines.emplace_back(W, p, model.equations[members[k]].integrations);
+  const bool weighted = !record.weights.empty() || model.weights;
+
+  // Window rows [begin, end) into one worker: chunks of at most block_rows that never cross a time
+  // block, each equation's rows evaluated, checked, interleaved as the whole design folds them
+  // (sample i, equation k at row i E + k) and folded into its time block's triangle.
+  const auto fold_part = [&](const WholeWindowValues& values, Worker& worker, std::size_t begin, std::size_t end) {
+    BlockEvaluator evaluator(record, evaluation, window, values);
+    MarkingValues marking(evaluator, worker.failed);
+    std::vector<Eigen::MatrixXd> A(E, Eigen::MatrixXd(static_cast<Eigen::Index>(block_rows), p));
+    std::vector<Eigen::VectorXd> b(E, Eigen::VectorXd(static_cast<Eigen::Index>(block_rows)));
+    std::vector<double> expression(model.weights ? block_rows : 0), products(block_rows);
+    Eigen::MatrixXd rows;
+    Eigen::VectorXd known, row_weights;
+    for (std::size_t start = begin; start < end && !worker.failed;) {
+      std::size_t tb = start * F / W;  // the time block holding `start`
+      while (W * (tb + 1) / F <= start) ++tb;
+      while (tb > 0 && W * tb / F > start) --tb;
+      const std::size_t stop = std::min({end, start + block_rows, W * (tb + 1) / F});
+      const std::size_t m = stop - start, first = window.first + start;
+      const auto mi = static_cast<Eigen::Index>(m);
+      evaluator.start_block(first, stop + window.first);
+      std::span<const double> expression_values;
+      if (model.weights) {
+        auto status = evaluator.evaluate(model.weights->value, std::span<double>(expression.data(), m));
+        if (std::holds_alternative<Diagnostic>(status) ||
+            check_weights(model, record, std::span<const double>(expression.data(), m), first)) {
+          worker.failed = true;
+          return;
+        }
+        expression_values = std::span<const double>(expression.data(), m);
+      }
+      const double* w = design.row_weights(r, first, expression_values, products);
+      for (std::size_t k = 0; k < E; ++k) {
+        A[k].topRows(mi).setZero();
+        if (design.equation_rows(r, members[k], marking, {A[k].topRows(mi), b[k].head(mi)}) || worker.failed) {
+          worker.failed = true;
+          return;
+        }
+      }
+      rows.resize(mi * static_cast<Eigen::Index>(E), p);
+      known.resize(rows.rows());
+      row_weights.resize(rows.rows());
+      for (std::size_t k = 0; k < E; ++k)
+        for (std::size_t i = 0; i < m; ++i) {
+          const auto to = static_cast<Eigen::Index>(i * E + k), from = static_cast<Eigen::Index>(i);
+          rows.row(to) = A[k].row(from);
+          known(to) = b[k](from);
+          row_weights(to) = w ? w[i] : 1.0;
+        }
+      if (!worker.blocks[tb].add_rows(rows, known, weighted ? &row_weights : nullptr)) {
+        worker.failed = true;
+        return;
+      }
+      for (std::size_t k = 0; k < E; ++k) worker.lines[k].add(start, A[k].topRows(mi));
+      start = stop;
+    }
+  };
+
+  const std::size_t stretch = running ? std::max<std::size_t>(options.stream_stretch_rows, 4) : W;
+  for (std::size_t begin = 0; begin < W; begin += stretch) {
+    const std::size_t end = std::min(W, begin + stretch);
+    if (running)
+      if (auto problem = running->advance(end, threads, block_rows)) return StreamedRows::use_whole_rows;
+    const WholeWindowValues& values = running ? running->values() : whole;
+    const std::size_t chunks = (end - begin + block_rows - 1) / block_rows;
+    const std::size_t parts = std::min<std::size_t>(static_cast<std::size_t>(threads), std::max<std::size_t>(chunks / 4, 1));
+    const auto bound = [&](std::size_t k) { return std::min(end, begin + chunks * k / parts * block_rows); };
+    for (std::size_t k = 0; k < parts; ++k) {
+      workers[k].lines.clear();
+      for (std::size_t e = 0; e < E; ++e) workers[k].lines.emplace_back(W, p, model.equations[members[e]].integrations);
+    }
+    std::vector<std::thread> pool;
+    for (std::size_t k = 1; k < parts; ++k) pool.emplace_back([&, k] { fold_part(values, workers[k], bound(k), bound(k + 1)); });
+    fold_part(values, workers[0], begin, bound(1));
+    for (auto& t : pool) t.join();
+    for (std::size_t k = 0; k < parts; ++k) {
+      if (workers[k].failed) return StreamedRows::use_whole_rows;
+      for (std::size_t e = 0; e < E; ++e) lines[e].join(workers[k].lines[e]);
+    }
+  }
+  for (const auto& w : workers)
+    for (std::size_t b = 0; b < F; ++b) blocks[b].merge(w.blocks[b]);
+  shares.clear();
+  for (const auto& l : lines) shares.push_back(l.shares());
+  return StreamedRows::folded;
+}
+
+}  // namespace sidc

@@ -179,6 +179,16 @@ class CsvParser {
 
   std::variant<Record, Diagnostic> run();
 
+  // run() in three steps, for a file given piece by piece (read_csv_in_pieces): the first piece,
+  // up to the first row (checks, header); rows of each piece; the record. A piece ends at a line end.
+  std::optional<Diagnostic> begin_text(const char*& p);
+  std::optional<Diagnostic> rows_of_text(const char* p);
+  std::variant<Record, Diagnostic> finish();
+  void set_text(std::string_view text) { text_ = text; }
+  // Whether `text` holds the line begin_text looks for first (neither blank nor a comment), whole.
+  bool holds_first_line(std::string_view text) const;
+  void reserve_rows(const char* p, std::size_t remaining);
+
  private:
   // Line bookkeeping.
   const char* begin() const { return text_.data(); }
@@ -209,15 +219,16 @@ class CsvParser {
   const char* split_point(const char* p) const;
   std::optional<Diagnostic> parse_rows_on_two_threads(const char* p, const char* split);
   CellValue slow_cell(const char*& p, std::string& text);
-  void reserve_rows(const char* p);
 
   std::string_view text_;
   const std::string& path_;
   CsvOptions options_;
   int line_ = 1;
+  int expected_line_ = 0;  // the line the next row is on when no line is skipped (line_jumps)
   char separator_ = ',';
   bool blank_separated_ = false;
   Record record_;
+  std::unique_ptr<CsvParser> tail_;  // parse_rows_on_two_threads' second parser
 };
 
 char CsvParser::detect_separator(const char* p) const {
@@ -308,10 +319,10 @@ std::optional<Diagnostic> CsvParser::split_header(const char*& p, std::vector<Fi
   return std::nullopt;
 }
 
-void CsvParser::reserve_rows(const char* p) {
-  // Estimate the row count from the first 64 KiB so that the columns grow without copying.
-  const std::size_t remaining = static_cast<std::size_t>(end() - p);
-  const std::size_t sample = std::min<std::size_t>(remaining, 1 << 16);
+void CsvParser::reserve_rows(const char* p, std::size_t remaining) {
+  // Estimate the row count of the `remaining` bytes (from p on, in this text and beyond) from the
+  // first 64 KiB, so that the columns grow without copying.
+  const std::size_t sample = std::min<std::size_t>({remaining, std::size_t{1} << 16, static_cast<std::size_t>(end() - p)});
   const auto lines = static_cast<std::size_t>(std::count(p, p + sample, '\n'));
   if (sample == 0 || lines == 0) return;
   const std::size_t estimate = remaining / sample * lines + remaining % sample * lines / sample + 16;
@@ -354,7 +365,6 @@ std::optional<Diagnostic> CsvParser::parse_rows(const char* p) {
   std::vector<std::size_t> faults_this_row;  // columns that recorded a fault text on this row
   std::string cell_text;
   std::size_t row = columns.empty() ? 0 : columns.front().size();  // rows already read (a continued parse)
-  int expected_line = 0;
   const char sep = separator_;
   const bool blanks = blank_separated_;
 
@@ -431,8 +441,8 @@ std::optional<Diagnostic> CsvParser::parse_rows(const char* p) {
       for (std::size_t j : faults_this_row) record_.first_faults[j].pop_back();
       continue;
     }
-    if (row_line != expected_line) record_.line_jumps.emplace_back(row, row_line);
-    expected_line = row_line + 1;
+    if (row_line != expected_line_) record_.line_jumps.emplace_back(row, row_line);
+    expected_line_ = row_line + 1;
     ++row;
   }
   return std::nullopt;
@@ -456,13 +466,21 @@ const char* CsvParser::split_point(const char* p) const {
 // the line number of the file; the result is the same as parse_rows(p) in every case.
 std::optional<Diagnostic> CsvParser::parse_rows_on_two_threads(const char* p, const char* split) {
   const std::string_view whole = text_;
-  CsvParser tail(std::string_view(split, static_cast<std::size_t>(end() - split)), path_, options_);
+  // The second parser is kept from piece to piece (read_csv_in_pieces): its columns' memory is
+  // reused, not faulted in afresh for every piece.
+  if (!tail_) tail_ = std::make_unique<CsvParser>(std::string_view(), path_, options_);
+  CsvParser& tail = *tail_;
+  tail.text_ = std::string_view(split, static_cast<std::size_t>(end() - split));
+  tail.line_ = 1;
+  tail.expected_line_ = 0;
   tail.separator_ = separator_;
   tail.blank_separated_ = blank_separated_;
   tail.record_.names = record_.names;
+  tail.record_.line_jumps.clear();
   tail.record_.columns.resize(record_.columns.size());
-  tail.record_.first_faults.resize(record_.first_faults.size());
-  tail.reserve_rows(split);
+  for (auto& column : tail.record_.columns) column.owned().clear();
+  tail.record_.first_faults.assign(record_.first_faults.size(), {});
+  tail.reserve_rows(split, static_cast<std::size_t>(end() - split));
   std::optional<Diagnostic> tail_error;
   std::thread second([&] { tail_error = tail.parse_rows(split); });
   text_ = std::string_view(whole.data(), static_cast<std::size_t>(split - whole.data()));
@@ -476,7 +494,6 @@ std::optional<Diagnostic> CsvParser::parse_rows_on_two_threads(const char* p, co
   for (std::size_t j = 0; j < record_.columns.size(); ++j) {
     auto& column = record_.columns[j];
     column.insert(column.end(), tail.record_.columns[j].begin(), tail.record_.columns[j].end());
-    tail.record_.columns[j] = {};
     auto& kept = record_.first_faults[j];
     for (auto& fault : tail.record_.first_faults[j]) {
       if (kept.size() >= kFaultsKeptPerColumn) break;
@@ -498,6 +515,29 @@ std::optional<Diagnostic> CsvParser::parse_rows_on_two_threads(const char* p, co
 }
 
 std::variant<Record, Diagnostic> CsvParser::run() {
+  const char* p = nullptr;
+  if (auto error = begin_text(p)) return *error;
+  reserve_rows(p, static_cast<std::size_t>(end() - p));
+  if (auto error = rows_of_text(p)) return *error;
+  return finish();
+}
+
+bool CsvParser::holds_first_line(std::string_view text) const {
+  const char* p = text.data();
+  const char* stop = text.data() + text.size();
+  if (text.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;
+  while (p < stop) {
+    while (p < stop && is_blank(*p)) ++p;
+    const char* line_end = p;
+    while (line_end < stop && !is_line_end(*line_end)) ++line_end;
+    if (line_end == stop) return false;  // not a whole line yet
+    if (p < line_end && !(options_.comment != 0 && *p == options_.comment)) return true;
+    p = line_end + 1;
+  }
+  return false;
+}
+
+std::optional<Diagnostic> CsvParser::begin_text(const char*& p) {
   if (std::string why; !options_.is_valid(&why)) return data_diag::invalid_csv_options(why);
   record_.path = path_;
   if (text_.empty()) return data_diag::empty_file(path_);
@@ -508,7 +548,7 @@ std::variant<Record, Diagnostic> CsvParser::run() {
     while (line_start > begin() && *(line_start - 1) != '\n') --line_start;
     return data_diag::binary_file(path_, static_cast<int>(row), static_cast<int>(at - line_start) + 1);
   }
-  const char* p = begin();
+  p = begin();
   if (text_.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;  // UTF-8 byte-order mark
 
   // The first line that is neither blank nor a comment: the header, or the first row.
@@ -562,14 +602,20 @@ std::variant<Record, Diagnostic> CsvParser::run() {
     line_ = first_line_number;
   }
 
-  reserve_rows(p);
-  if (const char* split = split_point(p)) {
-    if (auto error = parse_rows_on_two_threads(p, split)) return *error;
-  } else if (auto error = parse_rows(p)) {
-    return *error;
-  }
+  return std::nullopt;
+}
+
+std::optional<Diagnostic> CsvParser::rows_of_text(const char* p) {
+  if (const char* split = split_point(p)) return parse_rows_on_two_threads(p, split);
+  return parse_rows(p);
+}
+
+std::variant<Record, Diagnostic> CsvParser::finish() {
   if (record_.rows() == 0) return data_diag::no_data_rows(path_, record_.header_line);
-  for (auto& column : record_.columns) column.shrink_to_fit();
+  // Giving back what the estimate overshot (up to a fifth when the first rows are the shortest)
+  // would copy every column once more; only a far larger reserve is given back.
+  for (auto& column : record_.columns)
+    if (column.owned().capacity() > column.size() + column.size() / 4) column.shrink_to_fit();
   return std::move(record_);
 }
 
@@ -627,20 +673,103 @@ std::variant<Record, Diagnostic> parse_csv(std::string_view text, const std::str
   return parser.run();
 }
 
+namespace {
+
+Diagnostic refused(const std::string& path, const FileRefusal& refusal) {
+  switch (refusal.kind) {
+    case FileRefusal::Kind::directory: return data_diag::is_directory(path);
+    case FileRefusal::Kind::not_regular: return data_diag::not_a_regular_file(path, refusal.reason);
+    case FileRefusal::Kind::changed: return data_diag::changed_while_read(path, refusal.reason);
+    case FileRefusal::Kind::cannot_open: break;
+    case FileRefusal::Kind::no_memory: return data_diag::cannot_open(path, refusal.reason);
+  }
+  return data_diag::cannot_open(path, refusal.reason == std::strerror(ENOENT) ? "no such file" : refusal.reason);
+}
+
+// A file larger than CsvOptions::chunk_bytes, read and parsed piece by piece: each piece ends at
+// its last line end (a line longer than a piece grows the buffer), so memory is a piece, not the
+// file. Every answer is the whole file's: a file that changed while read is refused first, a NUL
+// byte anywhere next (the rest is still read for both), then the first parse problem.
+std::variant<Record, Diagnostic> read_csv_in_pieces(const OpenFile& file, const std::string& path, const CsvOptions& options) {
+  if (std::string why; !options.is_valid(&why)) return data_diag::invalid_csv_options(why);
+  std::size_t capacity = 2 * options.chunk_bytes;
+  std::unique_ptr<char[]> buffer(new (std::nothrow) char[capacity]);
+  if (!buffer) return data_diag::cannot_open(path, fmt::format("not enough memory for a piece of {} bytes", capacity));
+  CsvParser parser(std::string_view(), path, options);
+  std::size_t read = 0, held = 0;   // bytes read from the file; of them, still in the buffer
+  std::size_t newlines_before = 0;  // in the bytes already given up (for a NUL's row)
+  bool started = false, at_end = false;
+  std::optional<Diagnostic> binary, problem;
+  while (!at_end || held > 0) {
+    if (!at_end) {
+      if (held == capacity) {  // a line longer than the buffer: double it
+        std::unique_ptr<char[]> larger(new (std::nothrow) char[2 * capacity]);
+        if (!larger) return data_diag::cannot_open(path, fmt::format("not enough memory for a line of over {} bytes", capacity));
+        std::memcpy(larger.get(), buffer.get(), held);
+        buffer = std::move(larger);
+        capacity *= 2;
+      }
+      const long long got = file.read_at(buffer.get() + held, read, capacity - held);
+      if (got < 0) return data_diag::cannot_open(path, std::strerror(static_cast<int>(-got)));
+      if (!binary)
+        if (const void* nul = std::memchr(buffer.get() + held, '\0', static_cast<std::size_t>(got))) {
+          const char* at = static_cast<const char*>(nul);
+          const char* line_start = at;
+          while (line_start > buffer.get() && *(line_start - 1) != '\n') --line_start;
+          const auto row = 1 + newlines_before + static_cast<std::size_t>(std::count(static_cast<const char*>(buffer.get()), at, '\n'));
+          binary = data_diag::binary_file(path, static_cast<int>(row), static_cast<int>(at - line_start) + 1);
+        }
+      at_end = got == 0;
+      read += static_cast<std::size_t>(got);
+      held += static_cast<std::size_t>(got);
+      if (read > file.size()) break;  // grown: refused below
+    }
+    // The piece: up to the last line end (everything at the end of the file).
+    std::size_t cut = held;
+    if (!at_end) {
+      const char* last = buffer.get() + held;
+      while (last > buffer.get() && *(last - 1) != '\n') --last;
+      cut = static_cast<std::size_t>(last - buffer.get());
+      if (cut == 0) continue;  // no whole line yet
+    }
+    const std::string_view piece(buffer.get(), cut);
+    if (!binary && !problem) {
+      parser.set_text(piece);
+      if (!started) {
+        if (!at_end && !parser.holds_first_line(piece)) continue;  // blank and comment lines only so far: read on
+        const char* p = nullptr;
+        problem = parser.begin_text(p);
+        if (!problem) {
+          parser.reserve_rows(p, file.size() - (read - held) - static_cast<std::size_t>(p - piece.data()));
+          problem = parser.rows_of_text(p);
+        }
+        started = true;
+      } else {
+        problem = parser.rows_of_text(piece.data());
+      }
+    }
+    if (!binary) newlines_before += static_cast<std::size_t>(std::count(piece.begin(), piece.end(), '\n'));
+    std::memmove(buffer.get(), buffer.get() + cut, held - cut);
+    held -= cut;
+  }
+  if (read != file.size()) return data_diag::changed_while_read(path, changed_while_read(file.size(), read).reason);
+  if (binary) return *binary;
+  if (problem) return *problem;
+  if (!started) return data_diag::empty_file(path);
+  return parser.finish();
+}
+
+}  // namespace
+
 std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOptions& options) {
   // Read, not mapped (diagnostics/regular_file.hpp): a file truncated while it is read gives an
   // error, never SIGBUS; a FIFO or a device (/dev/zero) is refused before a byte is read.
-  auto read = read_regular_file(path);
-  if (auto* refusal = std::get_if<FileRefusal>(&read)) {
-    switch (refusal->kind) {
-      case FileRefusal::Kind::directory: return data_diag::is_directory(path);
-      case FileRefusal::Kind::not_regular: return data_diag::not_a_regular_file(path, refusal->reason);
-      case FileRefusal::Kind::changed: return data_diag::changed_while_read(path, refusal->reason);
-      case FileRefusal::Kind::cannot_open:
-        return data_diag::cannot_open(path, refusal->reason == std::strerror(ENOENT) ? "no such file" : refusal->reason);
-      case FileRefusal::Kind::no_memory: return data_diag::cannot_open(path, refusal->reason);
-    }
-  }
+  auto opened = open_regular_file(path);
+  if (auto* refusal = std::get_if<FileRefusal>(&opened)) return refused(path, *refusal);
+  const OpenFile& file = std::get<OpenFile>(opened);
+  if (options.chunk_bytes > 0 && file.size() > options.chunk_bytes) return read_csv_in_pieces(file, path, options);
+  auto read = read_open_file(file.descriptor(), file.size());
+  if (auto* refusal = std::get_if<FileRefusal>(&read)) return refused(path, *refusal);
   const auto& bytes = std::get<FileBytes>(read);
   return parse_csv(std::string_view(bytes.data.get(), bytes.size), path, options);
 }

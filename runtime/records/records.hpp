@@ -86,11 +86,15 @@ struct CsvOptions {
   // Rows' text at least this long is parsed on two threads (each half from a line start); the
   // record and every diagnostic are the same as on one thread. SIZE_MAX: always one thread.
   std::size_t parallel_above_bytes = std::size_t{8} << 20;
+  // read_csv reads a file larger than this in pieces of about this many bytes, each ending at a
+  // line end (a longer line grows the piece), so that the file is never held whole; every answer,
+  // record or diagnostic, is the whole file's. 0: always read whole.
+  std::size_t chunk_bytes = std::size_t{16} << 20;
 
   bool is_valid(std::string* why = nullptr) const;
 };
 
-// Maps (or, when it cannot be mapped, reads) a whole file and parses it in memory.
+// Reads a file (whole, or piece by piece above CsvOptions::chunk_bytes) and parses it.
 std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOptions& options = {});
 
 // The same, on text already in memory; `path` is only used in diagnostics.

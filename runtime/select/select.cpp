@@ -2,9 +2,11 @@
 //
 // Relies on: evaluate.hpp (Evaluator, fit_window), fit.hpp (FitOptions, equation_groups),
 // design.hpp (the columns and rows), triangular_accumulator.hpp, best_subset.hpp,
-// sequential_threshold.hpp, forward_regression.hpp. Guarantees: the header's. The rows of one
-// record are built over its fit window as the dense fit builds them, then cut into blocks of time
-// and folded; memory is p x n doubles while one record is evaluated, and O(F p^2) after.
+// sequential_threshold.hpp, forward_regression.hpp, streamed_rows.hpp. Guarantees: the header's.
+// The rows of one record are built over its fit window as the dense fit builds them, then cut into
+// blocks of time and folded: p x n doubles while one record is evaluated, and O(F p^2) after. A
+// record whose design exceeds FitOptions::stream_above_entries is streamed into the same blocks
+// (streamed_rows.hpp), in memory that does not grow with n.
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/select/select.hpp"
 

@@ -86,13 +86,27 @@ static Eigen::MatrixXd last_rows(const Eigen::MatrixXd& a, const Eigen::Ref<cons
 }
 
 void LineShareSums::accumulate(std::size_t first_level0, const Eigen::Ref<const Eigen::MatrixXd>& rows) {
-  Eigen::MatrixXd d = rows;
-  for (int i = 0; i < integrations_ && d.rows() > 0; ++i) d = (d.bottomRows(d.rows() - 1) - d.topRows(d.rows() - 1)).eval();
+  if (integrations_ == 0) return add_sums(first_level0, rows);
+  work_ = rows;
+  differences_in_work(first_level0);
+}
+
+// The I-th differences of the rows in work_, in place (v[i+1] - v[i], as operation_line_share
+// takes them), into the sums.
+void LineShareSums::differences_in_work(std::size_t first_level0) {
+  Eigen::Index n = work_.rows();
+  for (int level = 0; level < integrations_ && n > 0; ++level, --n)
+    for (Eigen::Index c = 0; c < work_.cols(); ++c)
+      for (Eigen::Index i = 0; i + 1 < n; ++i) work_(i, c) = work_(i + 1, c) - work_(i, c);
+  add_sums(first_level0, work_.topRows(std::max<Eigen::Index>(n, 0)));
+}
+
+void LineShareSums::add_sums(std::size_t first, const Eigen::Ref<const Eigen::MatrixXd>& d) {
   if (d.rows() == 0) return;
   // polynomial_energy_share's abscissa of each differenced row.
   Eigen::VectorXd x(d.rows());
   for (Eigen::Index i = 0; i < d.rows(); ++i) {
-    const auto k = static_cast<double>(first_level0 + static_cast<std::size_t>(i));
+    const auto k = static_cast<double>(first + static_cast<std::size_t>(i));
     x(i) = n_ > 1 ? 2.0 * k / static_cast<double>(n_ - 1) - 1.0 : 0.0;
   }
   gram_[0] += static_cast<double>(d.rows()), gram_[1] += x.sum(), gram_[2] += x.squaredNorm();
@@ -104,12 +118,20 @@ void LineShareSums::accumulate(std::size_t first_level0, const Eigen::Ref<const 
 void LineShareSums::add(std::size_t first, const Eigen::Ref<const Eigen::MatrixXd>& block) {
   if (count_ == 0) first_ = first;
   const auto I = static_cast<Eigen::Index>(integrations_);
-  Eigen::MatrixXd stacked(tail_.rows() + block.rows(), block.cols());
-  stacked << tail_, block;
-  accumulate(first_ + count_ - static_cast<std::size_t>(tail_.rows()), stacked);
-  if (head_.rows() < I) head_ = Eigen::MatrixXd(stacked.topRows(std::min(I, static_cast<Eigen::Index>(count_) + block.rows())));
-  tail_ = last_rows(tail_, block, I);
-  count_ += static_cast<std::size_t>(block.rows());
+  if (I == 0) {
+    add_sums(first, block);
+    count_ += static_cast<std::size_t>(block.rows());
+    return;
+  }
+  // [tail; block] in the work matrix (kept from call to call: no allocation per block).
+  const Eigen::Index held = tail_.rows(), m = block.rows();
+  work_.resize(held + m, block.cols());
+  work_.topRows(held) = tail_;
+  work_.bottomRows(m) = block;
+  if (head_.rows() < I) head_ = work_.topRows(std::min(I, held + m));
+  tail_ = work_.bottomRows(std::min(I, held + m));
+  differences_in_work(first_ + count_ - static_cast<std::size_t>(held));
+  count_ += static_cast<std::size_t>(m);
 }
 
 void LineShareSums::join(const LineShareSums& next) {

@@ -74,6 +74,8 @@ class LineShareSums {
 
  private:
   void accumulate(std::size_t first_level0, const Eigen::Ref<const Eigen::MatrixXd>& rows);  // the I-th differences of `rows`
+  void differences_in_work(std::size_t first_level0);
+  void add_sums(std::size_t first, const Eigen::Ref<const Eigen::MatrixXd>& differences);
 
   std::size_t n_;  // differenced rows in all
   int integrations_;
@@ -82,6 +84,7 @@ class LineShareSums {
   double gram_[3] = {0, 0, 0};         // sum 1, sum x, sum x^2
   Eigen::MatrixXd cross_;              // 2 x p: sum v, sum x v
   Eigen::VectorXd squares_;            // p: sum v^2
+  Eigen::MatrixXd work_;               // accumulate's differences
 };
 
 }  // namespace sidc

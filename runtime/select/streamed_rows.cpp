@@ -85,11 +85,10 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
   const auto fold_part = [&](const WholeWindowValues& values, Worker& worker, std::size_t begin, std::size_t end) {
     BlockEvaluator evaluator(record, evaluation, window, values);
     MarkingValues marking(evaluator, worker.failed);
-    std::vector<Eigen::MatrixXd> A(E, Eigen::MatrixXd(static_cast<Eigen::Index>(block_rows), p));
-    std::vector<Eigen::VectorXd> b(E, Eigen::VectorXd(static_cast<Eigen::Index>(block_rows)));
-    std::vector<double> expression(model.weights ? block_rows : 0), products(block_rows);
-    Eigen::MatrixXd rows;
-    Eigen::VectorXd known, row_weights;
+    // With several equations, each one's rows first apart, then interleaved into the fold's area.
+    std::vector<Eigen::MatrixXd> A(E > 1 ? E : 0, Eigen::MatrixXd(static_cast<Eigen::Index>(block_rows), p));
+    std::vector<Eigen::VectorXd> b(E > 1 ? E : 0, Eigen::VectorXd(static_cast<Eigen::Index>(block_rows)));
+    std::vector<double> expression(model.weights ? block_rows : 0), products(block_rows), row_weights(block_rows * E);
     for (std::size_t start = begin; start < end && !worker.failed;) {
       std::size_t tb = start * F / W;  // the time block holding `start`
       while (W * (tb + 1) / F <= start) ++tb;
@@ -109,28 +108,40 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
         expression_values = std::span<const double>(expression.data(), m);
       }
       const double* w = design.row_weights(r, first, expression_values, products);
-      for (std::size_t k = 0; k < E; ++k) {
-        A[k].topRows(mi).setZero();
-        if (design.equation_rows(r, members[k], marking, {A[k].topRows(mi), b[k].head(mi)}) || worker.failed) {
+      TriangularAccumulator& triangle = worker.blocks[tb];
+      auto area = triangle.rows_area(mi * static_cast<Eigen::Index>(E));  // [A b], folded in place
+      area.setZero();
+      if (E == 1) {
+        if (design.equation_rows(r, members[0], marking, {area.leftCols(p), area.col(p)}) || worker.failed) {
           worker.failed = true;
           return;
         }
-      }
-      rows.resize(mi * static_cast<Eigen::Index>(E), p);
-      known.resize(rows.rows());
-      row_weights.resize(rows.rows());
-      for (std::size_t k = 0; k < E; ++k)
-        for (std::size_t i = 0; i < m; ++i) {
-          const auto to = static_cast<Eigen::Index>(i * E + k), from = static_cast<Eigen::Index>(i);
-          rows.row(to) = A[k].row(from);
-          known(to) = b[k](from);
-          row_weights(to) = w ? w[i] : 1.0;
+        worker.lines[0].add(start, area.leftCols(p));  // before the weights
+      } else {
+        for (std::size_t k = 0; k < E; ++k) {
+          A[k].topRows(mi).setZero();
+          if (design.equation_rows(r, members[k], marking, {A[k].topRows(mi), b[k].head(mi)}) || worker.failed) {
+            worker.failed = true;
+            return;
+          }
+          worker.lines[k].add(start, A[k].topRows(mi));
+          for (std::size_t i = 0; i < m; ++i) {
+            const auto to = static_cast<Eigen::Index>(i * E + k), from = static_cast<Eigen::Index>(i);
+            area.row(to).head(p) = A[k].row(from);
+            area(to, p) = b[k](from);
+          }
         }
-      if (!worker.blocks[tb].add_rows(rows, known, weighted ? &row_weights : nullptr)) {
+      }
+      const double* fold_weights = nullptr;
+      if (weighted) {
+        for (std::size_t i = 0; i < m; ++i)
+          for (std::size_t k = 0; k < E; ++k) row_weights[i * E + k] = w ? w[i] : 1.0;
+        fold_weights = row_weights.data();
+      }
+      if (!triangle.fold_rows_area(mi * static_cast<Eigen::Index>(E), fold_weights)) {
         worker.failed = true;
         return;
       }
-      for (std::size_t k = 0; k < E; ++k) worker.lines[k].add(start, A[k].topRows(mi));
       start = stop;
     }
   };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sidc {
 namespace {
@@ -24,7 +25,7 @@ StepCheck check_uniform_step(std::span<const double> time, const UniformStepOpti
     check.bad_index = n;
     return check;
   }
-  std::vector<double> spacing(n - 1);
+  double least = std::numeric_limits<double>::infinity(), most = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(time[i])) {
       check.status = StepCheck::Status::not_finite;
@@ -38,8 +39,19 @@ StepCheck check_uniform_step(std::span<const double> time, const UniformStepOpti
       check.bad_index = i;
       return check;
     }
-    spacing[i - 1] = d;
+    least = std::min(least, d);
+    most = std::max(most, d);
   }
+  // Every spacing within the tolerance of the least one is every spacing within it of the median
+  // (|s - median| <= most - least, both differences exact by Sterbenz's lemma when the tolerance is
+  // below 1): the answer below without sorting 10^7 spacings.
+  if (options.relative_tolerance < 1 && most - least <= options.relative_tolerance * least) {
+    check.status = StepCheck::Status::uniform;
+    check.step = typical_step(time);
+    return check;
+  }
+  std::vector<double> spacing(n - 1);
+  for (std::size_t i = 1; i < n; ++i) spacing[i - 1] = time[i] - time[i - 1];
   // The median spacing, not the mean: one missing sample must not shift the reference so far
   // that a short record's good rows look bad and the gap itself is not the row named.
   std::vector<double> sorted = spacing;

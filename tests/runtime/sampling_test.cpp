@@ -2,6 +2,8 @@
 // data points (eq. 4-1.10).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -40,6 +42,46 @@ TEST(UniformStep, ToleratesJitterBelowTheTolerance) {
   UniformStepOptions strict;
   strict.relative_tolerance = 1e-5;
   EXPECT_EQ(check_uniform_step(t, strict).status, StepCheck::Status::not_uniform);
+}
+
+// The median test written out (the check's definition): every spacing within the tolerance of the
+// median spacing; otherwise the first that is not. check_uniform_step answers most grids from the
+// least and largest spacings alone; it must agree with this everywhere, near the tolerance too.
+StepCheck::Status by_the_median(const std::vector<double>& t, double tolerance, std::size_t& bad) {
+  std::vector<double> spacing;
+  for (std::size_t i = 1; i < t.size(); ++i) spacing.push_back(t[i] - t[i - 1]);
+  std::vector<double> sorted = spacing;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  for (std::size_t i = 0; i < spacing.size(); ++i)
+    if (std::fabs(spacing[i] - median) > tolerance * median) {
+      bad = i + 1;
+      return StepCheck::Status::not_uniform;
+    }
+  return StepCheck::Status::uniform;
+}
+
+TEST(UniformStep, TheQuickAnswerIsTheMediansAnswer) {
+  std::mt19937_64 random(11);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double step = std::ldexp(1.0, static_cast<int>(random() % 20) - 10) * (1 + 0.1 * static_cast<double>(random() % 7));
+    const double tolerance = std::array<double, 3>{1e-3, 1e-6, 0.2}[random() % 3];
+    // Jitter from well inside the tolerance to just beyond it, now and then one odd spacing.
+    const double jitter = tolerance * step * std::array<double, 5>{0.1, 0.49, 0.5, 0.51, 1.2}[random() % 5];
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<double> t{100.0 * step};
+    for (int i = 1; i < 50; ++i) t.push_back(t.back() + step + jitter * u(random));
+    if (random() % 4 == 0) t[1 + random() % 48] += 0.9 * tolerance * step * (random() % 2 ? 1 : -1);
+    UniformStepOptions options;
+    options.relative_tolerance = tolerance;
+    const StepCheck check = check_uniform_step(t, options);
+    std::size_t bad = 0;
+    const auto expected = by_the_median(t, tolerance, bad);
+    ASSERT_EQ(check.status, expected) << "trial " << trial;
+    if (expected == StepCheck::Status::not_uniform) {
+      EXPECT_EQ(check.bad_index, bad) << "trial " << trial;
+    }
+  }
 }
 
 TEST(UniformStep, NamesTheGapNotItsNeighbours) {

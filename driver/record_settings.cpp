@@ -67,8 +67,16 @@ ir::DataSource source_of(const ir::Model& model, const RecordInput& input) {
   return s;
 }
 
-std::variant<SampledRecord, Diagnostic> read_and_bind(RecordInput input, const ir::DataSource& source, const ir::Model& model, const BindOptions& bind) {
-  auto record = std::holds_alternative<std::string>(input) ? read_csv(std::get<std::string>(input))
+using Progress = std::function<void(const std::string& phase, std::size_t done, std::size_t total)>;
+
+std::variant<SampledRecord, Diagnostic> read_and_bind(RecordInput input, const ir::DataSource& source, const ir::Model& model, const BindOptions& bind,
+                                                      const Progress& progress = nullptr) {
+  CsvOptions csv;
+  if (progress && std::holds_alternative<std::string>(input))
+    csv.progress = [&progress, phase = "reading " + std::get<std::string>(input) + " (bytes)"](std::size_t done, std::size_t total) {
+      progress(phase, done, total);
+    };
+  auto record = std::holds_alternative<std::string>(input) ? read_csv(std::get<std::string>(input), csv)
                                                            : std::variant<Record, Diagnostic>(std::get<Record>(std::move(input)));
   if (auto* d = std::get_if<Diagnostic>(&record)) return *d;
   return bind_record(std::get<Record>(std::move(record)), source, model, bind);
@@ -77,7 +85,7 @@ std::variant<SampledRecord, Diagnostic> read_and_bind(RecordInput input, const i
 }  // namespace
 
 std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compiled, const std::string& directory, std::vector<RecordInput> inputs,
-                                                     const RecordSettings& a) {
+                                                     const RecordSettings& a, const Progress& progress) {
   const ir::Model& model = compiled.integrated;
   LoadedRecords out;
   if (!inputs.empty()) {
@@ -95,7 +103,7 @@ std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compil
   out.bind = bind_options(std::get<EvaluationSettings>(settings));
   out.bind.resample = a.resample;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
-    auto bound = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind);
+    auto bound = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress);
     if (auto* d = std::get_if<Diagnostic>(&bound)) return *d;
     out.records.push_back(std::get<SampledRecord>(std::move(bound)));
   }

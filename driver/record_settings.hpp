@@ -9,6 +9,8 @@
 // exception; a record given in memory is moved, never copied.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <variant>
@@ -51,8 +53,10 @@ struct LoadedRecords {
 
 // The records `inputs` name, each bound as the model's first data statement; with none, the
 // model's own data statements, relative paths taken from `directory` (the model file's folder).
-std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compiled, const std::string& directory, std::vector<RecordInput> inputs,
-                                                     const RecordSettings& settings);
+// `progress` (optional) hears how far each large CSV's reading is: "reading PATH (bytes)", done, total.
+std::variant<LoadedRecords, Diagnostic> load_records(
+    const CompiledModel& compiled, const std::string& directory, std::vector<RecordInput> inputs, const RecordSettings& settings,
+    const std::function<void(const std::string& phase, std::size_t done, std::size_t total)>& progress = nullptr);
 
 // One more record, bound like the others as the model's first data statement.
 std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind);

@@ -1,7 +1,9 @@
-// CSV reading: the whole file read into one buffer sized from the file (never mapped: a file
-// truncated while mapped ends the process with SIGBUS; diagnostics/regular_file.hpp), then one
-// pass over the bytes, on two threads for large files (the second half from a line start near the middle; see
-// parse_rows_on_two_threads). The fast path per cell
+// CSV reading: a file up to CsvOptions::chunk_bytes read whole into one buffer sized from the
+// file, a larger one in pieces that end at line ends (read_csv_in_pieces: the text is never held
+// whole), never mapped (a file truncated while mapped ends the process with SIGBUS;
+// diagnostics/regular_file.hpp); then one pass over the bytes of each, on two threads for large
+// ones (the second half from a line start near the middle; see parse_rows_on_two_threads). The
+// fast path per cell
 // reads the number straight off the buffer (read_simple_number, else std::from_chars; both stop
 // at the separator by themselves), so a cell costs one conversion and a comparison; everything
 // unusual (quotes, `+`, `D` exponents, decimal commas, text, NaN) falls to a slow path that
@@ -749,6 +751,7 @@ std::variant<Record, Diagnostic> read_csv_in_pieces(const OpenFile& file, const 
       }
     }
     if (!binary) newlines_before += static_cast<std::size_t>(std::count(piece.begin(), piece.end(), '\n'));
+    if (options.progress) options.progress(std::min(read, file.size()), file.size());
     std::memmove(buffer.get(), buffer.get() + cut, held - cut);
     held -= cut;
   }

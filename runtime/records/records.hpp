@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -90,6 +91,9 @@ struct CsvOptions {
   // line end (a longer line grows the piece), so that the file is never held whole; every answer,
   // record or diagnostic, is the whole file's. 0: always read whole.
   std::size_t chunk_bytes = std::size_t{16} << 20;
+  // Called after each piece of a file read in pieces, with the bytes read and the file's size (a
+  // progress line: cli/progress_line.hpp). Never called for a file read whole.
+  std::function<void(std::size_t bytes_read, std::size_t total)> progress;
 
   bool is_valid(std::string* why = nullptr) const;
 };

@@ -7,6 +7,7 @@
 // file, on one thread and (parallel_above_bytes small) on two within each piece.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <filesystem>
@@ -106,6 +107,27 @@ TEST(RecordsInPieces, TextsThatPutAPieceEndEverywhere) {
     const TextFile file(texts[k]);
     expect_same_in_pieces(file.path());
   }
+}
+
+TEST(RecordsInPieces, ProgressHearsEachPieceUpToTheWholeFile) {
+  std::string text = "t,x\n";
+  for (int i = 0; i < 1000; ++i) text += std::to_string(i) + "," + std::to_string(i * 0.5) + "\n";
+  const TextFile file(text);
+  std::vector<std::size_t> heard;
+  CsvOptions pieces;
+  pieces.chunk_bytes = 512;
+  pieces.progress = [&](std::size_t done, std::size_t total) {
+    EXPECT_EQ(total, text.size());
+    heard.push_back(done);
+  };
+  ASSERT_TRUE(std::holds_alternative<Record>(read_csv(file.path(), pieces)));
+  ASSERT_GT(heard.size(), 5u);
+  EXPECT_TRUE(std::is_sorted(heard.begin(), heard.end()));
+  EXPECT_EQ(heard.back(), text.size());
+  heard.clear();
+  pieces.chunk_bytes = 0;  // read whole: nothing to hear
+  ASSERT_TRUE(std::holds_alternative<Record>(read_csv(file.path(), pieces)));
+  EXPECT_TRUE(heard.empty());
 }
 
 TEST(RecordsInPieces, RandomTexts) {

@@ -143,16 +143,42 @@ Evaluator::Evaluator(const SampledRecord& record, const ir::Model& model, const 
     : record_(record), model_(model), options_(options), window_(window), segmented_(has_piecewise_inputs(model)) {}
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::signal(const std::string& name, int order, const Span& where) {
+  auto view = signal_view(name, order, where);
+  if (auto* d = std::get_if<Diagnostic>(&view)) return *d;
+  return *std::get<const Values*>(view);
+}
+
+std::variant<const std::vector<double>*, Diagnostic> Evaluator::signal_view(const std::string& name, int order, const Span& where) {
   const auto key = std::pair{name, order};
-  if (auto it = derivatives_.find(key); it != derivatives_.end()) return it->second;
+  if (auto it = derivatives_.find(key); it != derivatives_.end()) return &it->second;
   const auto found = record_.signals.find(name);
   if (found == record_.signals.end()) {
     return diag::signal_not_in_record(where, name, record_.path);
   }
-  if (order == 0) return derivatives_[key] = Values(found->second.begin(), found->second.end());
+  if (order == 0) return &(derivatives_[key] = Values(found->second.begin(), found->second.end()));
   auto estimate = derivative_operator(options_, order, name)->apply(found->second, record_.step);
   if (auto* d = std::get_if<Diagnostic>(&estimate)) return *d;
-  return derivatives_[key] = std::get<Values>(std::move(estimate));
+  return &(derivatives_[key] = std::get<Values>(std::move(estimate)));
+}
+
+std::variant<std::span<const double>, Diagnostic> Evaluator::factor_view(const ir::Factor& f, const Span& where, Values& scratch) {
+  if (f.kind == FactorKind::signal) {
+    auto view = signal_view(f.name, f.order, where);
+    if (auto* d = std::get_if<Diagnostic>(&view)) return *d;
+    return std::span<const double>(*std::get<const Values*>(view));
+  }
+  if (f.kind == FactorKind::derivative || f.kind == FactorKind::integral) {
+    const std::string key = print(f);
+    if (composite_.find(key) == composite_.end()) {  // factor() makes and keeps it
+      auto made = factor(f, where);
+      if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
+    }
+    return std::span<const double>(composite_.at(key));
+  }
+  auto made = factor(f, where);
+  if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
+  scratch = std::get<Values>(std::move(made));
+  return std::span<const double>(scratch);
 }
 
 std::variant<double, Diagnostic> Evaluator::initial_value(const ir::Factor& f, const Span& where) {
@@ -365,12 +391,19 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::interval_integrals(cons
 }
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t) {
+  Values v;
+  if (auto problem = term_into(t, v)) return *problem;
+  return v;
+}
+
+std::optional<Diagnostic> Evaluator::term_into(const ir::Term& t, Values& v) {
   const std::size_t n = record_.time.size();
-  Values v(n, t.coefficient.value());
+  v.assign(n, t.coefficient.value());
+  Values scratch;
   for (const auto& [f, power] : t.factors) {
-    auto values = factor(f, t.span);
+    auto values = factor_view(f, t.span, scratch);
     if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    const Values& x = std::get<Values>(values);
+    const std::span<const double> x = std::get<std::span<const double>>(values);
     if (f.kind == FactorKind::guard) {
       // 0 * NaN would be NaN: a guard that is off zeroes the term even where the rest has no value
       // (a derivative at the very edge), as eq. 4-1.9 defines the regions.
@@ -386,7 +419,7 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::term(const ir::Term& t)
       if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;
     }
   }
-  return v;
+  return std::nullopt;
 }
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate(const ir::Sum& s) {
@@ -401,22 +434,36 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate(const ir::Sum&
 }
 
 std::variant<std::vector<double>, Diagnostic> Evaluator::evaluate_in_window(const ir::Sum& s, const std::string& what) {
-  // Term by term, so that a value that is not finite is blamed on the term that made it.
-  Values total(window_.size(), 0.0);
+  Values total;
+  if (auto problem = evaluate_in_window(s, what, total)) return *problem;
+  return total;
+}
+
+std::optional<Diagnostic> Evaluator::evaluate_in_window(const ir::Sum& s, const std::string& what, std::vector<double>& total) {
+  // Term by term, so that a value that is not finite is blamed on the term that made it. Each term
+  // in the evaluator's own buffer, kept from sum to sum (a nested sum, inside a function or a der(),
+  // gets vectors of its own).
+  total.assign(window_.size(), 0.0);
+  Values own;
+  Values& v = term_buffer_busy_ ? own : term_buffer_;
+  const bool was_busy = term_buffer_busy_;
+  term_buffer_busy_ = true;
+  std::optional<Diagnostic> problem;
   for (const auto& t : s.terms) {
-    auto values = term(t);
-    if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-    const Values& v = std::get<Values>(values);
+    if ((problem = term_into(t, v))) break;
     for (std::size_t i = 0; i < window_.size(); ++i) {
       const double x = v[window_.first + i];
       if (!std::isfinite(x)) {
         const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
-        return diag::operation_not_finite(t.span, print(single), what, record_.time[window_.first + i], record_.path);
+        problem = diag::operation_not_finite(t.span, print(single), what, record_.time[window_.first + i], record_.path);
+        break;
       }
       total[i] += x;
     }
+    if (problem) break;
   }
-  return total;
+  term_buffer_busy_ = was_busy;
+  return problem;
 }
 
 }  // namespace sidc

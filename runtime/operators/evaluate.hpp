@@ -88,6 +88,8 @@ class Evaluator {
   // The same, cut to the fit window, with an error naming the term if a value in it is not finite;
   // `what` says whose term it is ("the operation of `a1`", "the known side").
   std::variant<std::vector<double>, Diagnostic> evaluate_in_window(const ir::Sum& s, const std::string& what);
+  // The same into `total` (its memory reused from call to call: a whole window is 80 MB at 10^7).
+  std::optional<Diagnostic> evaluate_in_window(const ir::Sum& s, const std::string& what, std::vector<double>& total);
 
   const FitWindow& window() const { return window_; }
   const SampledRecord& record() const { return record_; }
@@ -113,8 +115,14 @@ class Evaluator {
   std::variant<Values, Diagnostic> interval_integrals(const ir::Sum& s, int m);
   Evaluator& piece(int d);
   std::variant<Values, Diagnostic> term(const ir::Term& t);
+  std::optional<Diagnostic> term_into(const ir::Term& t, Values& v);
   std::variant<Values, Diagnostic> factor(const ir::Factor& f, const Span& where);
+  // The factor's values without a copy of what the evaluator keeps (a signal, its derivatives, an
+  // integral, a der()): a view of its cache, or of `scratch` where the values are made afresh. A
+  // whole record is 80 MB at 10^7 samples: copying each factor of each term dominated weak forms.
+  std::variant<std::span<const double>, Diagnostic> factor_view(const ir::Factor& f, const Span& where, Values& scratch);
   std::variant<Values, Diagnostic> signal(const std::string& name, int order, const Span& where);
+  std::variant<const Values*, Diagnostic> signal_view(const std::string& name, int order, const Span& where);
   std::variant<double, Diagnostic> initial_value(const ir::Factor& f, const Span& where);
 
   const SampledRecord& record_;
@@ -126,6 +134,8 @@ class Evaluator {
   bool segmented_ = false;
   std::vector<unsigned char> boundaries_;  // piece_boundaries(), made on first use
   std::shared_ptr<Pieces> pieces_;
+  Values term_buffer_;  // evaluate_in_window's terms, one after another
+  bool term_buffer_busy_ = false;
 };
 
 }  // namespace sidc

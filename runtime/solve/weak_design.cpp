@@ -73,9 +73,8 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
     auto& w = weights_[static_cast<std::size_t>(k)];
     if (w.empty()) w = test_function_weights(grid_, k, evaluator_.record().step);
     if (!evaluator_.segmented()) {
-      auto values = evaluator_.evaluate_in_window(ir::canonical(terms), what);
-      if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
-      const std::vector<double>& g = std::get<std::vector<double>>(values);
+      if (auto problem = evaluator_.evaluate_in_window(ir::canonical(terms), what, values_)) return problem;
+      const std::vector<double>& g = values_;
       for (std::size_t j = 0; j < grid_.centres.size() && j < out.size(); ++j) {
         const double* x = g.data() + (grid_.centres[j] - m);
         double s = 0;

@@ -41,6 +41,7 @@ class WeakValues final : public DesignValues {
   Evaluator& evaluator_;
   const TestFunctionGrid& grid_;
   std::vector<std::vector<double>> weights_;  // per derivative order of phi, made when first asked for
+  std::vector<double> values_;                // g_k on the window, its memory kept from sum to sum
 };
 
 struct WeakDesign {

@@ -16,32 +16,18 @@
 #include "runtime/solve/fit.hpp"
 
 #include "support/shell.hpp"
+#include "support/thesis_record.hpp"
 
 namespace sidc {
 namespace {
 
+using testing::appendix_a;
+using testing::compiled_text;
+
 // The file's text (tests/support/shell.hpp).
 std::string read(const std::string& path) { return testing::read_text(path); }
 
-ir::Model compiled_text(const std::string& name, const std::string& text) {
-  const auto r = compile(std::make_shared<const SourceFile>(name, text), {});
-  EXPECT_TRUE(r.ok()) << r.diagnostics.render_all();
-  return r.ok() ? *r.integrated : ir::Model{};
-}
-
 ir::Model compiled_file(const std::string& path) { return compiled_text(path, read(path)); }
-
-SampledRecord appendix_a(const ir::Model& model, int every = 1) {
-  auto record = read_csv(SIDC_SOURCE_DIR "/examples/thesis-4-1/appendix_a.csv");
-  EXPECT_TRUE(std::holds_alternative<Record>(record));
-  ir::DataSource source;
-  source.bindings = {{"t", "t"}, {"y", "y"}};
-  BindOptions bind;
-  bind.every = every;
-  auto bound = bind_record(std::get<Record>(record), source, model, bind);
-  EXPECT_TRUE(std::holds_alternative<SampledRecord>(bound)) << render(std::get<Diagnostic>(bound));
-  return std::get<SampledRecord>(std::move(bound));
-}
 
 FitOptions thesis_options() {
   FitOptions o;

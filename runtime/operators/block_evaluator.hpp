@@ -9,9 +9,8 @@
 //   k * (window - 1) / 2 samples, eqs. 3-1.2 to 3-1.8, and one extra window so that `shorten`
 //   edges, which move the stencil off centre near the end of whatever it is given, only touch the
 //   margin; an operator without a reach reads the whole record). Values are therefore
-//   identical, bit for bit, to Evaluator's on the whole record, except integer powers y^k with
-//   k >= 3, which are repeated products here (y^3 = y^2 * y) where Evaluator calls std::pow:
-//   they agree to a few units in the last place.
+//   identical, bit for bit, to Evaluator's on the whole record (integer powers y^k are the same
+//   repeated products in both, y^3 = y^2 * y).
 // - Values that depend on the whole window (integrals from t0, eqs. 2-1.4 and 2-2.5; initial
 //   values y(t0)) are given: evaluated once by an Evaluator over the whole record before the blocks
 //   (prepare_whole_window_values) and sliced, identical to the dense path at the cost of 8 bytes per

@@ -412,8 +412,12 @@ std::optional<Diagnostic> Evaluator::term_into(const ir::Term& t, Values& v) {
     }
     for (std::size_t i = 0; i < n; ++i) {
       double p = x[i];
-      if (power == 2) p = p * p;
-      else if (power != 1) p = std::pow(p, power);
+      if (power >= 2) {  // x^k = x^(k-1) * x, the block evaluator's ladder: the same bits, and no pow()
+        const double base = p;
+        for (int k = 2; k <= power; ++k) p *= base;
+      } else if (power != 1) {
+        p = std::pow(p, power);
+      }
       // A term already exactly zero stays zero where a later factor is infinite (x*y^-1 at
       // x = y = 0 evaluates to 0, not NaN); NaN still spreads, so a missing value is never hidden.
       if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;

@@ -10,7 +10,7 @@
 //   operation for operation, carried across stretches by the value at the last even sample, the
 //   last value, and the last three integrand values: given the same integrands, the values are
 //   identical, bit for bit, to prepare_whole_window_values'. The integrands are the block
-//   evaluator's, which equal Evaluator's except integer powers y^k, k >= 3 (a few ulps).
+//   evaluator's, which equal Evaluator's bit for bit.
 // - Nested integrals are carried innermost first: an outer integrand reads the inner integrals'
 //   values on the same stretch.
 // - What cannot be carried is said by carries() before any work, and the caller then prepares the

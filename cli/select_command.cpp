@@ -13,6 +13,7 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/output_check.hpp"
+#include "cli/progress_line.hpp"
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
@@ -85,7 +86,9 @@ int run_select(const SelectArguments& a) {
     }
     s.groups.push_back(std::move(group));
   }
-  auto prepared = driver::prepare_select(std::move(*compiled), a.model, fs::path(a.model).parent_path().string(), record_inputs(a.records), std::move(s));
+  ProgressLine progress;  // on stderr, only when it is a terminal
+  auto prepared = driver::prepare_select(std::move(*compiled), a.model, fs::path(a.model).parent_path().string(), record_inputs(a.records), std::move(s),
+                                         [&progress](const std::string& phase, std::size_t done, std::size_t total) { progress.update(phase, done, total); });
   if (auto* f = std::get_if<driver::Failure>(&prepared)) return fail(*f);
   driver::SelectRun& run = *std::get<std::unique_ptr<driver::SelectRun>>(prepared);
   if (!a.out.empty()) {  // before any work: select.json may not overwrite the model or a record

@@ -44,8 +44,9 @@ std::optional<Failure> check_names(const ir::Model& model, const SelectSettings&
 
 }  // namespace
 
-std::variant<std::unique_ptr<SelectRun>, Failure> prepare_select(CompiledModel compiled, std::string model_path, const std::string& directory,
-                                                                 std::vector<RecordInput> inputs, SelectSettings settings) {
+std::variant<std::unique_ptr<SelectRun>, Failure> prepare_select(
+    CompiledModel compiled, std::string model_path, const std::string& directory, std::vector<RecordInput> inputs, SelectSettings settings,
+    const std::function<void(const std::string& phase, std::size_t done, std::size_t total)>& progress) {
   auto run = std::make_unique<SelectRun>();
   run->compiled = std::move(compiled);
   run->model_path = std::move(model_path);
@@ -77,7 +78,7 @@ std::variant<std::unique_ptr<SelectRun>, Failure> prepare_select(CompiledModel c
   o.max_size = a.max_size;
   if (auto f = check_names(model, a, o)) return *f;
   if (std::string why; !o.is_valid(&why)) return failure(cli_diag::invalid_options(why), true);
-  auto loaded = load_records(c, directory, std::move(inputs), a.records);
+  auto loaded = load_records(c, directory, std::move(inputs), a.records, progress);
   if (auto* d = std::get_if<Diagnostic>(&loaded)) return failure(*d);
   run->loaded = std::get<LoadedRecords>(std::move(loaded));
   return run;

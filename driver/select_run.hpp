@@ -10,7 +10,9 @@
 // Diagnostics the command line prints; nothing is written or printed except through FitOutput.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -46,8 +48,10 @@ struct SelectRun {
   std::optional<SelectSummary> summary;
 };
 
-std::variant<std::unique_ptr<SelectRun>, Failure> prepare_select(CompiledModel compiled, std::string model_path, const std::string& directory,
-                                                                 std::vector<RecordInput> inputs, SelectSettings settings);
+// `progress` (optional) hears how far a large record's reading is, as for the fit.
+std::variant<std::unique_ptr<SelectRun>, Failure> prepare_select(
+    CompiledModel compiled, std::string model_path, const std::string& directory, std::vector<RecordInput> inputs, SelectSettings settings,
+    const std::function<void(const std::string& phase, std::size_t done, std::size_t total)>& progress = nullptr);
 
 // The search; the drift absorbers as warnings and the report through `out`.
 std::optional<Failure> run_select(SelectRun& run, const FitOutput& out);

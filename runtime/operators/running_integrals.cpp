@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -48,6 +49,14 @@ bool RunningIntegrals::carries(const ir::Model& model, const EvaluationOptions& 
 std::variant<RunningIntegrals, Diagnostic> RunningIntegrals::start(const SampledRecord& record, const ir::Model& model,
                                                                    const EvaluationOptions& options, FitWindow window,
                                                                    const std::vector<const ir::Sum*>& sums) {
+  if (!carries(model, options, window, sums)) {
+    auto prepared = prepare_whole_window_values(record, model, options, window, sums);
+    if (auto* d = std::get_if<Diagnostic>(&prepared)) return std::move(*d);
+    RunningIntegrals whole(record, options, window);
+    whole.values_ = std::get<WholeWindowValues>(std::move(prepared));
+    whole.prepared_whole_ = true;
+    return whole;
+  }
   // cumulative_integral()'s own check, so that the message is the one the whole window would give.
   if (!(record.step > 0) || !std::isfinite(record.step))
     return data_diag::invalid_signal_options("an integral", "the sample spacing must be a positive number");
@@ -85,11 +94,26 @@ std::variant<RunningIntegrals, Diagnostic> RunningIntegrals::start(const Sampled
   return running;
 }
 
+std::size_t RunningIntegrals::stretch_rows(std::size_t asked) const {
+  return prepared_whole_ ? window_.size() : std::max<std::size_t>(asked, 4);
+}
+
+void RunningIntegrals::restart() {
+  done_ = 0;
+  for (auto& c : carried_) {
+    c.even = c.last = 0;
+    std::fill(std::begin(c.history), std::end(c.history), 0.0);
+  }
+}
+
 std::optional<Diagnostic> RunningIntegrals::advance(std::size_t last, int threads, std::size_t block_rows) {
   const std::size_t first = done_;
-  if (last < first || last > window_.size() || (first == 0 && last < 4 && last != 0))
+  if (last < first || last > window_.size() || (!prepared_whole_ && first == 0 && last < 4 && last != 0))
     throw std::logic_error("RunningIntegrals::advance: not the next stretch of the window");
-  if (last == first) return std::nullopt;
+  if (last == first || prepared_whole_) {
+    done_ = last;
+    return std::nullopt;
+  }
   values_.integrals_first = window_.first + first;
   for (auto& c : carried_) {
     c.integrand_values.resize(last - first);

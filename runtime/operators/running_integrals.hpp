@@ -13,7 +13,7 @@
 //   evaluator's, which equal Evaluator's bit for bit.
 // - Nested integrals are carried innermost first: an outer integrand reads the inner integrals'
 //   values on the same stretch.
-// - What cannot be carried is said by carries() before any work, and the caller then prepares the
+// - What cannot be carried is said by carries() before any work, and start() then prepares the
 //   whole window at once: smoothing before integrating (its moving arc reads beyond a stretch),
 //   held or linear inputs (integrated segment by segment), an integral inside a derivative, an
 //   integral in the row weights, and windows of fewer than 4 samples (Simpson's first interval
@@ -39,17 +39,25 @@ class RunningIntegrals {
   static bool carries(const ir::Model& model, const EvaluationOptions& options, FitWindow window,
                       const std::vector<const ir::Sum*>& sums);
 
-  // Finds the integrals and evaluates the initial values (scalars) at once. Errors: the step is not
-  // positive, an initial value cannot be had (as Evaluator says).
+  // The window's integrals and initial values (scalars, evaluated at once): carried when carries()
+  // says so (the integrals found, none carried yet), else prepared over the whole record at once by
+  // prepare_whole_window_values, which every stretch then reads. Errors: the step is not positive,
+  // an initial value cannot be had, an integral cannot be prepared (as Evaluator says).
   static std::variant<RunningIntegrals, Diagnostic> start(const SampledRecord& record, const ir::Model& model,
                                                           const EvaluationOptions& options, FitWindow window,
                                                           const std::vector<const ir::Sum*>& sums);
 
+  bool carried() const { return !prepared_whole_; }
+  // The stretch to advance by: `asked` rows (at least 4) when carried, the whole window when not.
+  std::size_t stretch_rows(std::size_t asked) const;
+
   // Carries every integral over window samples [done(), last) (0-based in the window; at least 4
-  // samples on the first call unless the window is shorter), evaluating the integrands in blocks of
-  // `block_rows` on up to `threads` threads. A structural problem of an integrand is a Diagnostic;
-  // a value that is not finite is carried (the rows that read it report it).
+  // samples on the first call), evaluating the integrands in blocks of `block_rows` on up to
+  // `threads` threads. A structural problem of an integrand is a Diagnostic; a value that is not
+  // finite is carried (the rows that read it report it). Prepared whole: nothing to do.
   std::optional<Diagnostic> advance(std::size_t last, int threads, std::size_t block_rows);
+  // From t0 again (each equation of a group reads the same integrals from the start).
+  void restart();
 
   std::size_t done() const { return done_; }
   const WholeWindowValues& values() const { return values_; }
@@ -76,6 +84,7 @@ class RunningIntegrals {
   std::vector<Carried> carried_;  // innermost first (by depth)
   WholeWindowValues values_;
   std::size_t done_ = 0;
+  bool prepared_whole_ = false;
 };
 
 }  // namespace sidc

@@ -59,17 +59,9 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
   if (model.weights) sums.push_back(&model.weights->value);
 
   // Integrals carried, or (where they cannot be) the whole window's prepared at once.
-  std::optional<RunningIntegrals> running;
-  WholeWindowValues whole;
-  if (RunningIntegrals::carries(model, evaluation, window, sums)) {
-    auto started = RunningIntegrals::start(record, model, evaluation, window, sums);
-    if (auto* d = std::get_if<Diagnostic>(&started)) return *d;
-    running = std::get<RunningIntegrals>(std::move(started));
-  } else {
-    auto prepared = prepare_whole_window_values(record, model, evaluation, window, sums);
-    if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
-    whole = std::get<WholeWindowValues>(std::move(prepared));
-  }
+  auto started = RunningIntegrals::start(record, model, evaluation, window, sums);
+  if (auto* d = std::get_if<Diagnostic>(&started)) return *d;
+  RunningIntegrals& running = std::get<RunningIntegrals>(started);
 
   const int threads = stream_thread_count(options);
   const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
@@ -146,12 +138,11 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
     }
   };
 
-  const std::size_t stretch = running ? std::max<std::size_t>(options.stream_stretch_rows, 4) : W;
+  const std::size_t stretch = running.stretch_rows(options.stream_stretch_rows);
   for (std::size_t begin = 0; begin < W; begin += stretch) {
     const std::size_t end = std::min(W, begin + stretch);
-    if (running)
-      if (auto problem = running->advance(end, threads, block_rows)) return StreamedRows::use_whole_rows;
-    const WholeWindowValues& values = running ? running->values() : whole;
+    if (running.advance(end, threads, block_rows)) return StreamedRows::use_whole_rows;
+    const WholeWindowValues& values = running.values();
     const std::size_t chunks = (end - begin + block_rows - 1) / block_rows;
     const std::size_t parts = std::min<std::size_t>(static_cast<std::size_t>(threads), std::max<std::size_t>(chunks / 4, 1));
     const auto bound = [&](std::size_t k) { return std::min(end, begin + chunks * k / parts * block_rows); };

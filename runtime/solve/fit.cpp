@@ -86,8 +86,6 @@ struct StreamPlan {
   const FitOptions& options;
   const std::vector<EvaluationOptions>& evaluation;  // per record: its arcs under savgol(auto)
   const DesignBuilder& design;
-  std::vector<WholeWindowValues> whole;  // per record: all its integrals, or (carried) its initial values only
-  std::vector<char> carried;             // per record: integrals carried stretch by stretch (running_integrals.hpp)
   std::vector<const ir::Sum*> sums;      // every sum the rows evaluate: the design's, the guards', the weights'
   std::vector<std::string> guard_texts;  // the group's guards, in count_regions' order
   std::vector<ir::Sum> guard_sums;
@@ -204,7 +202,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
                                        const std::vector<FitWindow>& windows, const FitOptions& options,
                                        const std::vector<EvaluationOptions>& evaluation, const DesignBuilder& design,
                                        std::size_t total_rows, GroupFit& g) {
-  StreamPlan plan{model, records, windows, options, evaluation, design, {}, {}, {}, {}, {}};
+  StreamPlan plan{model, records, windows, options, evaluation, design, {}, {}, {}};
   for (const auto& [text, f] : guards_of(model, g.equations)) {
     plan.guard_texts.push_back(text);
     plan.guard_sums.push_back(ir::factor(f));
@@ -213,23 +211,12 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   for (const auto& s : plan.guard_sums) plan.sums.push_back(&s);
   if (model.weights) plan.sums.push_back(&model.weights->value);
   // Integrals are carried stretch by stretch where they can be (memory that does not grow with the
-  // record), and prepared over the whole record at once where they cannot.
-  std::vector<std::optional<RunningIntegrals>> fresh;  // per carried record: its integrals found, nothing carried yet
+  // record), and prepared over the whole record at once where they cannot (running_integrals.hpp).
+  std::vector<RunningIntegrals> integrals;  // per record
   for (std::size_t r = 0; r < records.size(); ++r) {
-    plan.carried.push_back(RunningIntegrals::carries(model, evaluation[r], windows[r], plan.sums));
-    fresh.emplace_back();
-    if (plan.carried[r]) {
-      auto running = RunningIntegrals::start(records[r], model, evaluation[r], windows[r], plan.sums);
-      if (auto* d = std::get_if<Diagnostic>(&running)) return *d;
-      fresh[r] = std::get<RunningIntegrals>(std::move(running));
-      WholeWindowValues initial;
-      initial.initial_values = fresh[r]->values().initial_values;
-      plan.whole.push_back(std::move(initial));
-      continue;
-    }
-    auto whole = prepare_whole_window_values(records[r], model, evaluation[r], windows[r], plan.sums);
-    if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
-    plan.whole.push_back(std::get<WholeWindowValues>(std::move(whole)));
+    auto started = RunningIntegrals::start(records[r], model, evaluation[r], windows[r], plan.sums);
+    if (auto* d = std::get_if<Diagnostic>(&started)) return *d;
+    integrals.push_back(std::get<RunningIntegrals>(std::move(started)));
   }
 
   // Weights from an expression: every row's checked first, record by record, as the dense path does.
@@ -237,7 +224,9 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
     const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
     std::vector<double> values(block_rows);
     for (std::size_t r = 0; r < records.size(); ++r) {
-      BlockEvaluator evaluator(records[r], evaluation[r], windows[r], plan.whole[r]);
+      // Before any stretch: the initial values, and (prepared whole) the integrals; carried ones are
+      // never in the weights (RunningIntegrals::carries).
+      BlockEvaluator evaluator(records[r], evaluation[r], windows[r], integrals[r].values());
       for (std::size_t start = 0; start < windows[r].size(); start += block_rows) {
         const std::size_t m = std::min(block_rows, windows[r].size() - start), first = windows[r].first + start;
         evaluator.start_block(first, first + m);
@@ -268,21 +257,17 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
     stream_rows(plan, whole, workers[0], r, e, begin, bound(1), count);
     for (auto& t : running) t.join();
   };
-  // Integrals are carried over stretches of this many rows, each stretch's integrands evaluated
-  // and its rows folded on every thread.
-  const std::size_t stretch = std::max<std::size_t>(options.stream_stretch_rows, 4);
+  // Carried integrals advance over stretches of FitOptions::stream_stretch_rows, each stretch's
+  // integrands evaluated and its rows folded on every thread; prepared ones are one stretch.
   for (std::size_t r = 0; r < records.size(); ++r) {
+    RunningIntegrals& running = integrals[r];
+    const std::size_t n = windows[r].size(), stretch = running.stretch_rows(options.stream_stretch_rows);
     for (std::size_t e : g.equations) {
-      const std::size_t n = windows[r].size();
-      if (!plan.carried[r]) {
-        fold_parts(plan.whole[r], r, e, 0, n);
-      } else {
-        RunningIntegrals running = *fresh[r];  // from t0 again for each equation
-        for (std::size_t begin = 0; begin < n; begin += stretch) {
-          const std::size_t end = std::min(n, begin + stretch);
-          if (auto problem = running.advance(end, threads, block_rows)) return problem;
-          fold_parts(running.values(), r, e, begin, end);
-        }
+      running.restart();  // from t0 again for each equation
+      for (std::size_t begin = 0; begin < n; begin += stretch) {
+        const std::size_t end = std::min(n, begin + stretch);
+        if (auto problem = running.advance(end, threads, block_rows)) return problem;
+        fold_parts(running.values(), r, e, begin, end);
       }
       // The dense path's first problem: the smallest key over the parts of this record and equation.
       Problem first;
@@ -544,27 +529,16 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
     if (w.size() > remaining) w.last = w.first + remaining - 1;
     remaining -= w.size();
     // The integrals as the fit had them: carried stretch by stretch, or the whole window at once.
-    const std::vector<const ir::Sum*> sums = design.sums();
-    const bool carried = RunningIntegrals::carries(model, evaluation, w, sums);
-    std::optional<RunningIntegrals> fresh;
-    WholeWindowValues whole;
-    if (carried) {
-      auto running = RunningIntegrals::start(records[r], model, evaluation, w, sums);
-      if (auto* d = std::get_if<Diagnostic>(&running)) return *d;
-      fresh = std::get<RunningIntegrals>(std::move(running));
-    } else {
-      auto prepared = prepare_whole_window_values(records[r], model, evaluation, w, sums);
-      if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
-      whole = std::get<WholeWindowValues>(std::move(prepared));
-    }
-    const std::size_t stretch = carried ? std::max<std::size_t>(options.stream_stretch_rows, 4) : w.size();
+    auto started = RunningIntegrals::start(records[r], model, evaluation, w, design.sums());
+    if (auto* d = std::get_if<Diagnostic>(&started)) return *d;
+    RunningIntegrals& running = std::get<RunningIntegrals>(started);
+    const std::size_t stretch = running.stretch_rows(options.stream_stretch_rows);
     for (std::size_t e : g.equations) {
-      std::optional<RunningIntegrals> running = fresh;
+      running.restart();
       for (std::size_t begin = 0; begin < w.size(); begin += stretch) {
         const std::size_t end = std::min(w.size(), begin + stretch);
-        if (running)
-          if (auto problem = running->advance(end, 1, block_rows)) return problem;
-        BlockEvaluator evaluator(records[r], evaluation, w, running ? running->values() : whole);
+        if (auto problem = running.advance(end, 1, block_rows)) return problem;
+        BlockEvaluator evaluator(records[r], evaluation, w, running.values());
         BlockValues values(evaluator, records[r], w, nullptr);
         for (std::size_t start = begin; start < end; start += block_rows) {
           const std::size_t m = std::min(block_rows, end - start);

@@ -39,7 +39,8 @@ struct FitArguments {
   std::string out;
   bool no_validate = false;
   std::vector<std::string> validate;  // further records, not used in fitting
-  std::size_t validate_samples = 100000;  // compared at most per record (0 = all)
+  std::size_t validate_samples = 0;       // compared at most per record (0 = all)
+  std::size_t refine_samples = 100000;    // fitted by --refine at most per record (0 = all)
   std::string initial_state = "estimate";  // the validation's start: estimated, or read from the record
   std::string plots;                  // --plots DIR
   std::string report;                 // --report FILE.html
@@ -75,6 +76,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   settings.no_validate = a.no_validate;
   settings.validate.assign(a.validate.begin(), a.validate.end());
   settings.validate_samples = a.validate_samples;
+  settings.refine_samples = a.refine_samples;
   settings.initial_state = a.initial_state == "record" ? InitialState::record : InitialState::estimate;
   settings.refine = a.refine;
   settings.estimator = a.estimator;
@@ -163,7 +165,8 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   add_record_options(cmd, a->records);
   add_form_options(cmd, a->form_options);
   cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv, validation.csv and (with --local or --forget) local.csv");
-  cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all)");
+  cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all, the default)");
+  cmd->add_option("--refine-samples", a->refine_samples, "Samples of each record the refinement (--refine) fits at most, from the start (default 100000; 0 = all)");
   cmd->add_option("--initial-state", a->initial_state,
                   "The validation's initial state: `estimate` (least squares over the record's start, the default) or `record` "
                   "(the first sample and its moving-arc derivatives)")

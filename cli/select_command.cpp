@@ -36,7 +36,7 @@ struct SelectArguments {
   std::uint64_t seed = 1;
   int max_size = -1;
   bool simulate = false;                   // rank the sizes by free-run simulation error too
-  std::size_t simulate_samples = 100000;   // per record, as sidc fit --validate-samples
+  std::size_t simulate_samples = 100000;   // per record, as sidc fit --validate-samples (every size is solved)
   std::string rule = "elbow";
   bool keep_drift = false;  // search drift absorbers of integrated equations too
   std::string out;

@@ -143,7 +143,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     } else {
       RefineOptions ro;
       ro.evaluation = o.evaluation;
-      ro.max_samples = a.validate_samples;
+      ro.max_samples = a.refine_samples;
       ro.from = o.from;
       ro.to = o.to;
       std::vector<const SampledRecord*> fitted;

@@ -40,7 +40,8 @@ struct FitSettings {
   std::optional<ir::IntegrationRequest> form;  // --integrate/--form: every equation rewritten so
   bool no_validate = false;
   std::vector<RecordInput> validate;          // records only compared with, not fitted
-  std::size_t validate_samples = 100000;      // compared at most per record (0 = all)
+  std::size_t validate_samples = 0;           // compared at most per record (0 = all)
+  std::size_t refine_samples = 100000;        // fitted by the refinement at most per record (0 = all)
   InitialState initial_state = InitialState::estimate;
   bool refine = false;
   std::string estimator;                      // "", least_squares or iv: over the model's `set estimator`

@@ -291,7 +291,10 @@ std::string validation_csv(const FitValidation& v) {
   for (const auto& run : v.runs)
     for (std::size_t i = 0; i < run.simulation.time.size(); ++i) {
       out += fmt::format("{},{}", csv_field(run.record), run.simulation.time[i]);
-      for (std::size_t j = 0; j < run.outputs.size(); ++j) out += fmt::format(",{},{},{}", run.recorded[j][i], run.simulated[j][i], run.error[j][i]);
+      for (std::size_t j = 0; j < run.outputs.size(); ++j) {
+        const double y = run.recorded[j][i], yhat = run.simulation.outputs[j][i];
+        out += fmt::format(",{},{},{}", y, yhat, y - yhat);  // E, eq. 4-1.4
+      }
       out += "\n";
     }
   return out;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 #include <stdexcept>
 
@@ -12,6 +13,7 @@
 #include "diagnostics/model_catalogue.hpp"
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/operators/point_evaluator.hpp"
+#include "runtime/operators/weighted_point_sum.hpp"
 #include "runtime/operators/savitzky_golay.hpp"
 #include "runtime/not_a_number.hpp"
 
@@ -20,38 +22,29 @@ namespace {
 
 std::string prime(const std::string& name, int order) { return name + std::string(static_cast<std::size_t>(order), '\''); }
 
-// A ParametricSum with the parameter values substituted: sum_k weight_k * sum_k(point). Each
-// part's value is kept for the sensitivity equations, where d/d a_k of the sum is part k itself.
-struct Weighted {
-  struct Part {
-    double weight = 1;
-    int parameter = -1;  // the parameter whose value `weight` is; -1 for the parameter-free part
-    PointSum sum;
-  };
-  std::vector<Part> parts;
-  mutable std::vector<double> values;  // of each part at the last evaluation
-  double operator()(const PointInstant& at) const {
-    values.resize(parts.size());
-    double v = 0;
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-      values[i] = parts[i].sum.evaluate(at);
-      v += parts[i].weight * values[i];
-    }
-    return v;
-  }
-};
+// A ParametricSum with the parameter values substituted, sum_k a_k * term_k(point), is a
+// WeightedPointSum; each part's value is kept for the sensitivity equations, where d/d a_k of the
+// sum is part k itself.
+using Weighted = WeightedPointSum;
 
 // The 4-point cubic through the samples around t (Lagrange form); the stencil shifts inward at
 // the ends of the grid. Exact for cubics, so the interpolation error is O(h^4), RK4's order.
-// `hint`: the sample interval the stepper is in, tried before a binary search.
-double interpolate_cubic(const std::vector<double>& time, const std::vector<double>& v, double t, std::size_t hint) {
+// `hint`: the sample interval of the last call, tried with the next one before a binary search
+// (steppers move forward), and set to the interval found.
+double interpolate_cubic(const std::vector<double>& time, const std::vector<double>& v, double t, std::size_t& hint) {
   const std::size_t n = time.size();
   if (n == 1) return v[0];
+  auto inside = [&](std::size_t k) { return k + 1 < n && time[k] <= t && t < time[k + 1]; };
   std::size_t k = hint;
-  if (!(hint + 1 < n && time[hint] <= t && t < time[hint + 1])) {
-    auto upper = std::upper_bound(time.begin(), time.end(), t);
-    k = upper == time.begin() ? 0 : static_cast<std::size_t>(upper - time.begin()) - 1;  // time[k] <= t
+  if (!inside(k)) {
+    if (inside(k + 1)) {
+      ++k;
+    } else {
+      auto upper = std::upper_bound(time.begin(), time.end(), t);
+      k = upper == time.begin() ? 0 : static_cast<std::size_t>(upper - time.begin()) - 1;  // time[k] <= t
+    }
   }
+  hint = k;
   if (k >= n - 1) k = n - 2;
   if (n < 4) {
     const double a = (t - time[k]) / (time[k + 1] - time[k]);
@@ -82,10 +75,7 @@ class System {
     auto weighted = [&](const ParametricSum& p, Weighted& out) -> std::optional<Diagnostic> {
       auto add = [&](double w, int parameter, const ir::Sum& s) -> std::optional<Diagnostic> {
         if (s.empty() || (w == 0 && !sensitivities_)) return std::nullopt;
-        auto c = compile_point_sum(s, layout_, compile_options_);
-        if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
-        out.parts.push_back({w, parameter, std::get<PointSum>(std::move(c))});
-        return std::nullopt;
+        return out.add(w, parameter, s, layout_, compile_options_);
       };
       if (auto d = add(1.0, -1, p.constant)) return d;
       for (const auto& t : p.terms)
@@ -113,9 +103,7 @@ class System {
           for (const auto& t : p.terms)
             if (auto d = add(o.parameters[static_cast<std::size_t>(t.parameter)], t.operation, output.span)) return d;
           if (total.empty()) continue;
-          auto c = compile_point_sum(total, layout_, compile_options_);
-          if (auto* e = std::get_if<Diagnostic>(&c)) return *e;
-          out[m].parts.push_back({1.0, -1, std::get<PointSum>(std::move(c))});
+          if (auto e = out[m].add(1.0, -1, total, layout_, compile_options_)) return e;
         }
       return std::nullopt;
     };
@@ -259,7 +247,7 @@ class System {
     }
     double det = 0;
     if (k == 1) {
-      const double a = coefficient_[0][0](at), r = rest_[0](at);
+      const double a = coefficient_[0][0].evaluate(at), r = rest_[0].evaluate(at);
       det = a;
       out[state_offset_[0] + static_cast<std::size_t>(form_->outputs[0].order) - 1] = -r / a;
       if (sensitivities_) {
@@ -270,8 +258,8 @@ class System {
       a_.resize(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
       Eigen::VectorXd r(k);
       for (std::size_t i = 0; i < k; ++i) {
-        for (std::size_t j = 0; j < k; ++j) a_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = coefficient_[i][j](at);
-        r(static_cast<Eigen::Index>(i)) = rest_[i](at);
+        for (std::size_t j = 0; j < k; ++j) a_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = coefficient_[i][j].evaluate(at);
+        r(static_cast<Eigen::Index>(i)) = rest_[i].evaluate(at);
       }
       Eigen::PartialPivLU<Eigen::MatrixXd> lu(a_);
       det = lu.determinant();
@@ -379,16 +367,16 @@ class System {
       double* g = &g_[i * n];
       double* c = &c_[i * q_count];
       auto add_parameters = [&](const Weighted& w, double factor) {
-        for (std::size_t p = 0; p < w.parts.size(); ++p)
-          if (w.parts[p].parameter >= 0) c[w.parts[p].parameter] += factor * w.values[p];
+        for (std::size_t p = 0; p < w.parts(); ++p)
+          if (w.parameter(p) >= 0) c[w.parameter(p)] += factor * w.part_value(p);
       };
       for (std::size_t m = 0; m < n; ++m)
-        if (!rest_partial_[i][m].parts.empty()) g[m] += rest_partial_[i][m](at);
+        if (!rest_partial_[i][m].empty()) g[m] += rest_partial_[i][m].evaluate(at);
       add_parameters(rest_[i], 1.0);
       for (std::size_t j = 0; j < k; ++j) {
         const double zj = z_(static_cast<Eigen::Index>(j));
         for (std::size_t m = 0; m < n; ++m)
-          if (!coefficient_partial_[i][j][m].parts.empty()) g[m] += zj * coefficient_partial_[i][j][m](at);
+          if (!coefficient_partial_[i][j][m].empty()) g[m] += zj * coefficient_partial_[i][j][m].evaluate(at);
         add_parameters(coefficient_[i][j], zj);
       }
       const double* sensitivity = state + n;  // column q of S starts at q * n
@@ -423,20 +411,27 @@ class System {
     const std::vector<double>* column = nullptr;  // a recorded input's samples, in the options
     std::vector<double> owned;                    // or its estimated derivative
     const std::vector<double>& values() const { return column ? *column : owned; }
+    // The last value read and where: RK4's two middle stages read the same instant.
+    mutable double last_t = std::numeric_limits<double>::quiet_NaN(), last_value = 0;
+    mutable std::size_t last_interval = 0;
+    mutable std::size_t hint = 0;  // interpolate_cubic's
   };
   // A recorded input at t, within the current interval for a held or linear one.
   double recorded(const Source& s, double t) const {
     const std::vector<double>& time = options_->time;
     const std::size_t k = interval_;
+    if (t == s.last_t && k == s.last_interval) return s.last_value;
     const std::vector<double>& v = s.values();
+    double value = kNaN;
     switch (s.hold) {
-      case ir::Signal::Hold::smooth: return interpolate_cubic(time, v, t, k);
-      case ir::Signal::Hold::held: return v[k];
+      case ir::Signal::Hold::smooth: value = interpolate_cubic(time, v, t, s.hint); break;
+      case ir::Signal::Hold::held: value = v[k]; break;
       case ir::Signal::Hold::linear:
-        if (time.size() < 2) return v[0];
-        return v[k] + (v[k + 1] - v[k]) * (t - time[k]) / (time[k + 1] - time[k]);
+        value = time.size() < 2 ? v[0] : v[k] + (v[k + 1] - v[k]) * (t - time[k]) / (time[k + 1] - time[k]);
+        break;
     }
-    return kNaN;
+    s.last_t = t, s.last_interval = k, s.last_value = value;
+    return value;
   }
 
   const ExplicitForm* form_ = nullptr;
@@ -491,10 +486,10 @@ std::optional<std::string> divergence(const State& s, const ExplicitForm& form, 
   for (std::size_t j = 0; j < form.outputs.size(); ++j)
     for (int m = 0; m < form.outputs[j].order; ++m) {
       const double v = s[offsets[j] + static_cast<std::size_t>(m)];
+      if (std::abs(v) <= bound) continue;  // the name is made only for a bad one: this runs every step
       const std::string name = prime(form.outputs[j].name, m);
       if (!std::isfinite(v)) return fmt::format("the simulation diverged: `{}` is not finite at t = {:.6g}", name, t);
-      if (std::abs(v) > bound)
-        return fmt::format("the simulation diverged: |{}| = {:.3g} exceeds {:.3g} at t = {:.6g}", name, std::abs(v), bound, t);
+      return fmt::format("the simulation diverged: |{}| = {:.3g} exceeds {:.3g} at t = {:.6g}", name, std::abs(v), bound, t);
     }
   return std::nullopt;
 }
@@ -680,6 +675,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
         }
         t = o.time[row];
         record(row, s);
+        if (o.progress && (row % 65536 == 0 || row + 1 == n)) o.progress(row + 1, n);
       }
     };
     try {
@@ -712,6 +708,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
           }
           stepper.calc_state(o.time[row], s);
           record(row, s);
+          if (o.progress && (row % 65536 == 0 || row + 1 == n)) o.progress(row + 1, n);
         }
       } else {
         step_rows(odeint::make_controlled(o.absolute_tolerance, o.relative_tolerance, odeint::runge_kutta_cash_karp54<State>()));
@@ -779,7 +776,11 @@ std::variant<std::map<std::string, std::vector<double>>, Diagnostic> initial_sta
       }
       DerivativeOptions d = derivative_options_for(options, out.name, m);
       d.edges = DerivativeOptions::Edges::shorten;
-      auto estimate = estimate_derivative(column->second, record.step, m, d);
+      // The samples up to the arc's reach past `index` give the same value there as the whole record
+      // (a shortened edge only moves stencils within the reach of the end): no whole-record pass for one value.
+      const std::size_t reach = MovingArcOperator(m, d).reach().value_or(column->second.size());
+      const std::size_t needed = std::min(column->second.size(), index + reach + 1);
+      auto estimate = estimate_derivative(std::span<const double>(column->second).first(needed), record.step, m, d);
       if (auto* e = std::get_if<Diagnostic>(&estimate)) return *e;
       values.push_back(std::get<std::vector<double>>(estimate)[index]);
     }

@@ -1,6 +1,7 @@
 #include "runtime/simulate/validate.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <fmt/format.h>
@@ -21,21 +22,46 @@ std::vector<std::pair<std::string, double>> named_state(const ExplicitForm& form
 
 namespace {
 
-// The first time the local RMS of `e` (kDepartureHalfWidth samples either side, those that are
+constexpr double kNotFinite = -1;  // a square's place when the error is not finite (squares are >= 0)
+
+// The first time the local RMS of e = y - yhat (kDepartureHalfWidth samples either side, those that are
 // finite) exceeds `limit`; none when it never does.
-std::optional<double> departure(const std::vector<double>& e, const std::vector<double>& time, double limit) {
-  const std::size_t n = e.size(), w = kDepartureHalfWidth;
+// Each square is taken once (a whole record has millions of samples, each in 11 windows), kept in
+// a ring of the window's length, and the window's squares are added in sample order, as a sum
+// over the window taken afresh would.
+std::optional<double> departure(const std::vector<double>& y, const std::vector<double>& yhat, const std::vector<double>& time, double limit) {
+  const std::size_t n = y.size(), w = kDepartureHalfWidth, length = 2 * w + 1;
+  std::array<double, 2 * kDepartureHalfWidth + 1> ring;  // squares[k] at k % length; kNotFinite where e[k] is not finite
+  auto square = [&](std::size_t k) {
+    const double e = y[k] - yhat[k];
+    return std::isfinite(e) ? e * e : kNotFinite;
+  };
+  for (std::size_t k = 0; k < std::min(n, w + 1); ++k) ring[k % length] = square(k);
   for (std::size_t i = 0; i < n; ++i) {
-    double squares = 0;
+    if (i + w < n && i > 0) ring[(i + w) % length] = square(i + w);  // the window's new right end
+    double sum = 0;
     std::size_t count = 0;
     for (std::size_t k = i > w ? i - w : 0; k <= std::min(n - 1, i + w); ++k)
-      if (std::isfinite(e[k])) squares += e[k] * e[k], ++count;
-    if (count && std::sqrt(squares / static_cast<double>(count)) > limit) return time[i];
+      if (const double s = ring[k % length]; s != kNotFinite) sum += s, ++count;
+    if (count && std::sqrt(sum / static_cast<double>(count)) > limit) return time[i];
   }
   return std::nullopt;
 }
 
 }  // namespace
+
+SimulateOptions::Method free_run_method(const ir::Model& normalized, const ExplicitForm& form) {
+  if (!form.switching_functions.empty()) return SimulateOptions::Method::rk4;
+  for (const auto& s : normalized.signals)
+    if (s.kind == ir::Signal::Kind::input && !s.definition && s.hold != ir::Signal::Hold::smooth) return SimulateOptions::Method::rk4;
+  return SimulateOptions::Method::adaptive;
+}
+
+std::string free_run_description(SimulateOptions::Method method, const ValidationOptions& options) {
+  if (method == SimulateOptions::Method::adaptive)
+    return fmt::format("dopri5 (adaptive steps, tolerance {:g}, dense output at the samples)", options.tolerance);
+  return fmt::format("RK4, {} step{} per sample interval", options.substeps, options.substeps == 1 ? "" : "s");
+}
 
 const char* to_string(InitialState initial) { return initial == InitialState::record ? "record" : "estimate"; }
 
@@ -108,12 +134,15 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   v.recorded_state = named_state(form, o.initial);
   v.initial_method = options.initial_state;
   if (options.initial_state == InitialState::estimate && o.time.size() >= 2) {
-    const InitialStateEstimate estimate = estimate_initial_state(normalized, form, o, recorded, start_segment_samples(o.time.size()));
+    SimulateOptions segment = o;  // RK4 however the free run is solved (ValidationOptions::choose_method)
+    segment.method = SimulateOptions::Method::rk4;
+    const InitialStateEstimate estimate = estimate_initial_state(normalized, form, segment, recorded, start_segment_samples(o.time.size()));
     o.initial = estimate.initial;
     v.start_segment = estimate.segment;
     v.estimate_iterations = estimate.iterations;
   }
   v.initial_state = named_state(form, o.initial);
+  if (options.choose_method) o.method = free_run_method(normalized, form);
   if (options.progress)
     o.progress = [&options, &record](std::size_t done, std::size_t total) { options.progress(record.path, done, total); };
   auto run = simulate(normalized, form, o);
@@ -125,11 +154,12 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     const std::vector<double>& yhat = v.simulation.outputs[j];
     OutputValidation r;
     r.output = form.outputs[j].name;
-    std::vector<double> e(y.size());
+    // E = y - yhat, eq. 4-1.4: observed - approximated; taken afresh where needed rather than held
+    // (a whole record's curve is 80 MB at 10^7 samples; validation.csv takes it the same way).
+    auto e = [&](std::size_t i) { return y[i] - yhat[i]; };
     double max_observed = 0, mean = 0, sum_e2 = 0, sum_d2 = 0;
     for (std::size_t i = 0; i < y.size(); ++i) {
-      e[i] = y[i] - yhat[i];  // eq. 4-1.4: observed - approximated
-      if (!std::isfinite(e[i])) continue;
+      if (!std::isfinite(e(i))) continue;
       ++r.samples;
       mean += y[i];
     }
@@ -138,13 +168,14 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     // (or 1e-200) gives the same fit % and a finite RMS error.
     double scale = 0;
     for (std::size_t i = 0; i < y.size(); ++i)
-      if (std::isfinite(e[i])) scale = std::max({scale, std::abs(e[i]), std::abs(y[i] - mean)});
+      if (const double ei = e(i); std::isfinite(ei)) scale = std::max({scale, std::abs(ei), std::abs(y[i] - mean)});
     for (std::size_t i = 0; i < y.size(); ++i) {
-      if (!std::isfinite(e[i])) continue;
+      const double ei = e(i);
+      if (!std::isfinite(ei)) continue;
       max_observed = std::max(max_observed, std::abs(y[i]));
-      if (std::abs(e[i]) > r.max_abs_error) r.max_abs_error = std::abs(e[i]), r.time_of_max = o.time[i];
+      if (std::abs(ei) > r.max_abs_error) r.max_abs_error = std::abs(ei), r.time_of_max = o.time[i];
       if (scale == 0) continue;
-      sum_e2 += (e[i] / scale) * (e[i] / scale);
+      sum_e2 += (ei / scale) * (ei / scale);
       sum_d2 += ((y[i] - mean) / scale) * ((y[i] - mean) / scale);
     }
     r.percent_error = max_observed > 0 ? 100 * r.max_abs_error / max_observed : NAN;  // eq. 4-1.5
@@ -155,12 +186,10 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     r.rms_error = r.samples ? scale * std::sqrt(sum_e2 / static_cast<double>(r.samples)) : NAN;
     r.follows = v.simulation.completed() && r.fit_percent >= kFollowsFitPercent;
     const double spread = r.samples ? scale * std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;
-    r.departs_at = departure(e, o.time, kDepartureShare * spread);
+    r.departs_at = departure(y, yhat, o.time, kDepartureShare * spread);
     if (!r.departs_at && !v.simulation.completed()) r.departs_at = v.simulation.stopped_at;
     v.outputs.push_back(r);
-    v.recorded.push_back(y);
-    v.simulated.push_back(yhat);
-    v.error.push_back(std::move(e));
+    v.recorded.push_back(std::move(prepared_run.recorded[j]));  // not read again
   }
   v.follows = v.simulation.completed() && std::all_of(v.outputs.begin(), v.outputs.end(), [](const OutputValidation& r) { return r.follows; });
   if (v.simulation.completed()) {
@@ -219,7 +248,6 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
                            const std::string& refined_by,
                            const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress) {
   FitValidation v;
-  if (refined) v.method += ", with the parameters " + refined_by;
   v.max_samples = max_samples;
   if (!summary.is_solution_usable()) {
     v.note = "skipped: the fit is rank deficient, so its parameters are not worth simulating";
@@ -231,6 +259,9 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   }
   const std::vector<double> parameters = refined ? *refined : fitted_parameter_values(normalized, summary, 0.0);
   ValidationOptions o;
+  o.choose_method = true;
+  v.method = free_run_description(free_run_method(normalized, std::get<ExplicitForm>(form)), o);
+  if (refined) v.method += ", with the parameters " + refined_by;
   o.evaluation = evaluation;
   o.max_samples = max_samples;
   o.initial_state = initial_state;
@@ -259,6 +290,7 @@ std::optional<double> simulation_rms_error(const ir::Model& normalized, const Ex
     // The derivative form's parameters come first in the fitted model's order (integrate_pass.cpp).
     if (!subset[i].record && subset[i].parameter < parameters.size()) parameters[subset[i].parameter] = values[i];
   ValidationOptions v;
+  v.choose_method = true;
   v.evaluation = evaluation;
   v.max_samples = max_samples;
   double squares = 0;

@@ -65,6 +65,9 @@ struct ValidationOptions {
   SimulateOptions::Method method = SimulateOptions::Method::rk4;
   int substeps = 4;           // rk4, the thesis' solver: four steps per sample interval
   double tolerance = 1e-9;    // adaptive
+  // The free run's method from the model instead (free_run_method()); the initial-state estimate
+  // keeps RK4 with `substeps` either way (its forward differences need a run smooth in the start).
+  bool choose_method = false;
   EvaluationOptions evaluation;  // the fit's, for the initial derivatives (edges are always shortened)
   // Samples compared at most, from the start (0 = all). A free run costs about 2 us per equation
   // evaluation, 16 per sample: 10^7 samples would take minutes, so sidc fit bounds it.
@@ -77,6 +80,18 @@ struct ValidationOptions {
   // Optional: the free run's progress (SimulateOptions::progress), with the record's path.
   std::function<void(const std::string& record, std::size_t done, std::size_t total)> progress;
 };
+
+// The solver of a validation's free run: the adaptive stepper (Odeint's dopri5 with dense output
+// at the samples, tolerance 1e-9), whose steps span as many sample intervals as the solution
+// allows: a finely sampled record (thousands of samples per period) is not stepped four times per
+// sample, which made the whole-record validation of 10^7 samples take over a minute. RK4 at four
+// steps per sample instead when the equations have guard or sign() switches (RK4 locates each and
+// steps to it exactly; the adaptive controller only shrinks its steps there) or a recorded input
+// declared held or linear (every sample is then a jump or a kink that RK4 steps to).
+SimulateOptions::Method free_run_method(const ir::Model& normalized, const ExplicitForm& form);
+// How free_run_method()'s choice is named in the report: "RK4, 4 steps per sample interval" or
+// "dopri5 (adaptive steps, tolerance 1e-09, dense output at the samples)".
+std::string free_run_description(SimulateOptions::Method method, const ValidationOptions& options);
 
 struct OutputValidation {
   std::string output;
@@ -100,7 +115,9 @@ struct ValidationSummary {
   int estimate_iterations = 0;       // Levenberg-Marquardt steps taken
   bool follows = false;              // every output follows
   std::vector<OutputValidation> outputs;
-  std::vector<std::vector<double>> recorded, simulated, error;  // per output, on simulation.time
+  // Per output, on simulation.time: the record (the solution is simulation.outputs, the error
+  // E = recorded - simulated, eq. 4-1.4, not held: 8 bytes a sample less).
+  std::vector<std::vector<double>> recorded;
   std::string statement;  // one plain sentence: how well, or where it diverged
   bool truncated = false;  // ValidationOptions::max_samples stopped it before the record's end
   std::string report(const std::string& method) const;

@@ -136,6 +136,24 @@ TEST(Verdict, SaysWhereAWrongModelDepartsAndByHowMuch) {
   EXPECT_GE(*y.departs_at, bad.simulation.time.front());
   EXPECT_LT(*y.departs_at, y.time_of_max);
   EXPECT_GT(y.max_abs_error, 0.5);
+  {  // where it departs, as the definition says: the first local RMS error (11 samples) above a tenth of y's spread
+    const std::vector<double>& recorded = bad.recorded[0];
+    std::vector<double> e(recorded.size());
+    for (std::size_t i = 0; i < e.size(); ++i) e[i] = recorded[i] - bad.simulation.outputs[0][i];
+    double mean = 0, squares = 0;
+    for (double v : recorded) mean += v / static_cast<double>(recorded.size());
+    for (double v : recorded) squares += (v - mean) * (v - mean);
+    const double limit = kDepartureShare * std::sqrt(squares / static_cast<double>(recorded.size()));
+    std::optional<double> first;
+    for (std::size_t i = 0; i < e.size() && !first; ++i) {
+      double sum = 0;
+      std::size_t count = 0;
+      for (std::size_t k = i >= kDepartureHalfWidth ? i - kDepartureHalfWidth : 0; k <= std::min(e.size() - 1, i + kDepartureHalfWidth); ++k)
+        if (std::isfinite(e[k])) sum += e[k] * e[k], ++count;
+      if (count && std::sqrt(sum / static_cast<double>(count)) > limit) first = bad.simulation.time[i];
+    }
+    EXPECT_EQ(first, y.departs_at);
+  }
   std::cout << bad.statement << "\n";
   EXPECT_NE(bad.statement.find("do not follow it: fit "), std::string::npos) << bad.statement;
   EXPECT_NE(bad.statement.find(fmt::format("departs at t = {:.4g}", *y.departs_at)), std::string::npos) << bad.statement;

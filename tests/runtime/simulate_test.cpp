@@ -400,6 +400,51 @@ TEST(Validate, ReproducesItsOwnRecordAndReportsDivergence) {
   EXPECT_NE(runaway.statement.find("could not be solved"), std::string::npos) << runaway.statement;
 }
 
+// The fit's validation solves a smooth model with the adaptive stepper (steps spanning many
+// samples) and gets the numbers RK4 at 4 steps per sample gets, to the solvers' accuracy; guard
+// and sign() switches, and held or linear inputs, keep RK4 (it steps to each exactly).
+TEST(Validate, SolverChosenFromTheEquationsAgreesWithRk4) {
+  const ir::Model m = normalized("input x\noutput y\nparam m, c, k, k3\nm*y'' + c*y' + k*y + k3*y^3 = x\n");
+  const ExplicitForm f = form_of(m);
+  EXPECT_EQ(free_run_method(m, f), SimulateOptions::Method::adaptive);
+  const ir::Model guarded = normalized("input x\noutput y\nparam a, b, c\na*y'' + b*y'*[y > 0] + c*y = x\n");
+  EXPECT_EQ(free_run_method(guarded, form_of(guarded)), SimulateOptions::Method::rk4);
+  const ir::Model friction = normalized("input x\noutput y\nparam a, b, c\na*y'' + b*sign(y') + c*y = x\n");
+  EXPECT_EQ(free_run_method(friction, form_of(friction)), SimulateOptions::Method::rk4);
+  const ir::Model held = normalized("input x held\noutput y\nparam a, b\na*y' + b*y = x\n");
+  EXPECT_EQ(free_run_method(held, form_of(held)), SimulateOptions::Method::rk4);
+
+  const std::vector<double> truth_parameters = {1.0, 0.3, 4.0, 2.0};
+  SimulateOptions o;
+  o.parameters = truth_parameters;
+  o.initial["y"] = {0.5, 0.0};
+  o.time = grid(0, 40, 0.01);
+  o.substeps = 10;
+  for (double t : o.time) o.inputs["x"].push_back(std::cos(1.3 * t));
+  const auto truth = run(m, f, o);
+  SampledRecord record;
+  record.path = "duffing.csv";
+  record.step = 0.01;
+  record.time = o.time;
+  record.signals["y"] = truth.outputs[0];
+  record.signals["x"] = o.inputs["x"];
+  ValidationOptions rk4, chosen;
+  chosen.choose_method = true;
+  std::vector<double> off = truth_parameters;
+  off[3] *= 0.9;  // a validation with something to show: a cubic stiffness 10% off
+  for (const auto& parameters : {truth_parameters, off}) {
+    const auto a = std::get<ValidationSummary>(validate(m, f, parameters, record, rk4));
+    const auto b = std::get<ValidationSummary>(validate(m, f, parameters, record, chosen));
+    ASSERT_TRUE(b.simulation.completed()) << b.simulation.message;
+    ASSERT_EQ(a.simulation.outputs[0].size(), b.simulation.outputs[0].size());
+    double difference = 0;
+    for (std::size_t i = 0; i < a.simulation.outputs[0].size(); ++i) difference = std::max(difference, std::abs(a.simulation.outputs[0][i] - b.simulation.outputs[0][i]));
+    EXPECT_LT(difference, 1e-6);
+    EXPECT_NEAR(a.outputs[0].fit_percent, b.outputs[0].fit_percent, 1e-4);
+    EXPECT_EQ(a.initial_state, b.initial_state);  // the start is estimated by RK4 either way
+  }
+}
+
 // Fit % and RMS error read the same in small units (a linear model's record scaled by 1e-200),
 // a record beyond the divergence bound (1e8) is said not to be solved rather than given a fit %,
 // and a record reproduced exactly is a fit of 100%, a constant one too (issue 19).

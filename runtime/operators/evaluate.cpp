@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 #include "diagnostics/data_catalogue.hpp"
 #include "runtime/operators/piecewise_inputs.hpp"
 #include "runtime/not_a_number.hpp"
+#include "runtime/parallel_ranges.hpp"
 #include <stdexcept>
 
 namespace sidc {
@@ -404,24 +406,30 @@ std::optional<Diagnostic> Evaluator::term_into(const ir::Term& t, Values& v) {
     auto values = factor_view(f, t.span, scratch);
     if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
     const std::span<const double> x = std::get<std::span<const double>>(values);
+    // Sample by sample, so a long record's samples split over the cores (parallel_ranges.hpp).
     if (f.kind == FactorKind::guard) {
       // 0 * NaN would be NaN: a guard that is off zeroes the term even where the rest has no value
       // (a derivative at the very edge), as eq. 4-1.9 defines the regions.
-      for (std::size_t i = 0; i < n; ++i) v[i] = x[i] == 0.0 ? 0.0 : v[i] * x[i];
+      for_parallel_ranges(n, n, [&](std::size_t first, std::size_t last) {
+        for (std::size_t i = first; i < last; ++i) v[i] = x[i] == 0.0 ? 0.0 : v[i] * x[i];
+      });
       continue;
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      double p = x[i];
-      if (power >= 2) {  // x^k = x^(k-1) * x, the block evaluator's ladder: the same bits, and no pow()
-        const double base = p;
-        for (int k = 2; k <= power; ++k) p *= base;
-      } else if (power != 1) {
-        p = std::pow(p, power);
+    const int k_power = power;
+    for_parallel_ranges(n, n * static_cast<std::size_t>(std::max(1, k_power)), [&](std::size_t first, std::size_t last) {
+      for (std::size_t i = first; i < last; ++i) {
+        double p = x[i];
+        if (k_power >= 2) {  // x^k = x^(k-1) * x, the block evaluator's ladder: the same bits, and no pow()
+          const double base = p;
+          for (int k = 2; k <= k_power; ++k) p *= base;
+        } else if (k_power != 1) {
+          p = std::pow(p, k_power);
+        }
+        // A term already exactly zero stays zero where a later factor is infinite (x*y^-1 at
+        // x = y = 0 evaluates to 0, not NaN); NaN still spreads, so a missing value is never hidden.
+        if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;
       }
-      // A term already exactly zero stays zero where a later factor is infinite (x*y^-1 at
-      // x = y = 0 evaluates to 0, not NaN); NaN still spreads, so a missing value is never hidden.
-      if (v[i] != 0.0 || std::isnan(p)) v[i] *= p;
-    }
+    });
   }
   return std::nullopt;
 }
@@ -455,16 +463,26 @@ std::optional<Diagnostic> Evaluator::evaluate_in_window(const ir::Sum& s, const 
   std::optional<Diagnostic> problem;
   for (const auto& t : s.terms) {
     if ((problem = term_into(t, v))) break;
-    for (std::size_t i = 0; i < window_.size(); ++i) {
-      const double x = v[window_.first + i];
-      if (!std::isfinite(x)) {
-        const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
-        problem = diag::operation_not_finite(t.span, print(single), what, record_.time[window_.first + i], record_.path);
-        break;
+    // The first sample without a value names the problem; ranges of samples on every core.
+    constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+    std::atomic<std::size_t> first_bad{kNone};
+    for_parallel_ranges(window_.size(), window_.size(), [&](std::size_t first, std::size_t last) {
+      for (std::size_t i = first; i < last; ++i) {
+        const double x = v[window_.first + i];
+        if (!std::isfinite(x)) {
+          std::size_t seen = first_bad.load();
+          while (i < seen && !first_bad.compare_exchange_weak(seen, i)) {
+          }
+          return;
+        }
+        total[i] += x;
       }
-      total[i] += x;
+    });
+    if (const std::size_t i = first_bad.load(); i != kNone) {
+      const ir::Sum single = ir::canonical(std::vector<ir::Term>{t});
+      problem = diag::operation_not_finite(t.span, print(single), what, record_.time[window_.first + i], record_.path);
+      break;
     }
-    if (problem) break;
   }
   term_buffer_busy_ = was_busy;
   return problem;

@@ -1,0 +1,29 @@
+// Element-wise work over a whole record on every core: [0, n) cut into one contiguous range per
+// thread, each range's elements computed exactly as one thread would (no sum crosses a range), so
+// the values are the same bits on any number of cores. Below `serial_below` units of work the call
+// runs on the caller's thread alone (a thread costs tens of microseconds to start).
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <thread>
+#include <vector>
+
+namespace sidc {
+
+// f(first, last) for ranges covering [0, n); `work` is n times the cost of one element, in
+// multiply-adds, say.
+template <class F>
+void for_parallel_ranges(std::size_t n, std::size_t work, F&& f, std::size_t serial_below = std::size_t{1} << 22) {
+  const std::size_t threads = work < serial_below || n < 2 ? 1 : std::min<std::size_t>(n, std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  if (threads == 1) {
+    f(std::size_t{0}, n);
+    return;
+  }
+  std::vector<std::thread> running;
+  for (std::size_t t = 1; t < threads; ++t) running.emplace_back([&f, n, t, threads] { f(n * t / threads, n * (t + 1) / threads); });
+  f(std::size_t{0}, n / threads);
+  for (auto& t : running) t.join();
+}
+
+}  // namespace sidc

@@ -19,9 +19,7 @@ class StartProblem {
  public:
   StartProblem(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& whole, const std::vector<std::vector<double>>& recorded,
                std::size_t segment)
-      : model_(model), form_(form), options_(whole), recorded_(recorded), segment_(segment) {
-    options_.time.resize(segment);
-    for (auto& [name, values] : options_.inputs) values.resize(segment);
+      : model_(model), form_(form), options_(whole.first_samples(segment)), recorded_(recorded), segment_(segment) {
     const double duration = options_.time.back() - options_.time.front();
     for (std::size_t j = 0; j < form.outputs.size(); ++j) {
       // Finite and non-zero in any unit, so the residuals below are of order 1.

@@ -512,6 +512,28 @@ bool SimulateOptions::is_valid(std::string* why) const {
   return true;
 }
 
+SimulateOptions SimulateOptions::first_samples(std::size_t n) const {
+  SimulateOptions out;
+  out.method = method;
+  out.substeps = substeps;
+  out.stepper = stepper;
+  out.absolute_tolerance = absolute_tolerance;
+  out.relative_tolerance = relative_tolerance;
+  out.locate_switches = locate_switches;
+  out.divergence_bound = divergence_bound;
+  out.parameters = parameters;
+  out.initial = initial;
+  const std::size_t kept = std::min(n, time.size());
+  out.time.assign(time.begin(), time.begin() + static_cast<std::ptrdiff_t>(kept));
+  for (const auto& [name, values] : inputs)
+    out.inputs[name].assign(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(kept, values.size())));
+  out.t0_for_tau = t0_for_tau;
+  out.initial_value = initial_value;
+  out.sensitivities = sensitivities;
+  out.progress = progress;
+  return out;
+}
+
 std::string SimulationSummary::brief_report() const {
   const double first = time.empty() ? 0.0 : time.front(), last = time.empty() ? 0.0 : time.back();
   std::string out = status == Status::completed ? fmt::format("simulation: completed from t = {:.6g} to {:.6g}", first, last)

@@ -69,6 +69,10 @@ struct SimulateOptions {
   std::function<void(std::size_t done, std::size_t total)> progress;
 
   bool is_valid(std::string* why) const;
+  // These options with the grid and the input samples cut to their first `n` (a start segment of a
+  // long record: copying 10^7 samples to keep 1000 costs more than the segment's run). Every other
+  // setting as it is: a field added above must be added to this copy too.
+  SimulateOptions first_samples(std::size_t n) const;
 };
 
 struct SimulationSummary {

@@ -140,9 +140,8 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   v.recorded_state = named_state(form, o.initial);
   v.initial_method = options.initial_state;
   if (options.initial_state == InitialState::estimate && o.time.size() >= 2) {
-    SimulateOptions segment = o;  // RK4 however the free run is solved (ValidationOptions::choose_method)
-    segment.method = SimulateOptions::Method::rk4;
-    const InitialStateEstimate estimate = estimate_initial_state(normalized, form, segment, recorded, start_segment_samples(o.time.size()));
+    // With options.method (RK4 by default); ValidationOptions::choose_method changes only the free run below.
+    const InitialStateEstimate estimate = estimate_initial_state(normalized, form, o, recorded, start_segment_samples(o.time.size()));
     o.initial = estimate.initial;
     v.start_segment = estimate.segment;
     v.estimate_iterations = estimate.iterations;

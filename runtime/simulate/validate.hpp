@@ -66,7 +66,8 @@ struct ValidationOptions {
   int substeps = 4;           // rk4, the thesis' solver: four steps per sample interval
   double tolerance = 1e-9;    // adaptive
   // The free run's method from the model instead (free_run_method()); the initial-state estimate
-  // keeps RK4 with `substeps` either way (its forward differences need a run smooth in the start).
+  // keeps `method` (RK4 by default: its forward differences need a run smooth in the start, which
+  // an adaptive stepper's step choices are not).
   bool choose_method = false;
   EvaluationOptions evaluation;  // the fit's, for the initial derivatives (edges are always shortened)
   // Samples compared at most, from the start (0 = all). A free run costs about 2 us per equation

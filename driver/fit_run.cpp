@@ -79,6 +79,10 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
   auto options = fit_options(c.integrated, run->settings.records);
   if (auto* d = std::get_if<Diagnostic>(&options)) return failure(*d, true);
   run->options = std::get<FitOptions>(options);
+  if (out.progress)
+    run->options.progress = [progress = out.progress](std::size_t done, std::size_t total) {
+      progress("fitting: rows folded into the triangular factor", done, total);
+    };
   auto loaded = load_records(c, directory, std::move(inputs), run->settings.records, out.progress);
   if (auto* d = std::get_if<Diagnostic>(&loaded)) return failure(*d);
   run->loaded = std::get<LoadedRecords>(std::move(loaded));

@@ -259,6 +259,8 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   };
   // Carried integrals advance over stretches of FitOptions::stream_stretch_rows, each stretch's
   // integrands evaluated and its rows folded on every thread; prepared ones are one stretch.
+  std::size_t folded = 0, to_fold = 0;
+  for (const auto& w : windows) to_fold += w.size() * g.equations.size();
   for (std::size_t r = 0; r < records.size(); ++r) {
     RunningIntegrals& running = integrals[r];
     const std::size_t n = windows[r].size(), stretch = running.stretch_rows(options.stream_stretch_rows);
@@ -268,6 +270,8 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
         const std::size_t end = std::min(n, begin + stretch);
         if (auto problem = running.advance(end, threads, block_rows)) return problem;
         fold_parts(running.values(), r, e, begin, end);
+        folded += end - begin;
+        if (options.progress) options.progress(folded, to_fold);
       }
       // The dense path's first problem: the smallest key over the parts of this record and equation.
       Problem first;

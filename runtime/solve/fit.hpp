@@ -51,6 +51,9 @@ struct FitOptions {
   // Integrals from t0 are carried from stretch to stretch of this many rows (at least 4), so a
   // streamed integrated form holds one stretch of each integral (runtime/operators/running_integrals.hpp).
   std::size_t stream_stretch_rows = std::size_t{1} << 17;
+  // Optional: a streamed group's rows folded so far and in all (per equation and record), after
+  // each stretch, from the calling thread (a progress line; nothing computed depends on it).
+  std::function<void(std::size_t done, std::size_t total)> progress;
   bool is_valid(std::string* why) const;
 };
 

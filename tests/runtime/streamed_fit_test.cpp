@@ -146,6 +146,24 @@ TEST(StreamedFit, IntegratedFormSeveralRecordsAndEveryOtherSample) {
   expect_same_fit(fitted(m, {records[1]}, thesis_options()), fitted(m, {records[1]}, streamed(thesis_options(), 3)));
 }
 
+// The progress hook: after every stretch, rows folded so far rising to all of them (both records).
+TEST(StreamedFit, TellsItsProgressStretchByStretch) {
+  const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
+  const std::vector<SampledRecord> records{appendix_a(m), appendix_a(m, 2)};
+  FitOptions o = streamed(thesis_options());
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  o.progress = [&calls](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
+  const FitSummary s = fitted(m, records, o);
+  ASSERT_EQ(s.groups.size(), 1u);
+  ASSERT_GT(calls.size(), 2u);  // stretches of 22 rows over two records of about 80 and 40 rows
+  for (std::size_t k = 1; k < calls.size(); ++k) {
+    EXPECT_GT(calls[k].first, calls[k - 1].first);
+    EXPECT_EQ(calls[k].second, calls[0].second);
+  }
+  EXPECT_EQ(calls.back().first, calls.back().second);
+  EXPECT_EQ(calls.back().second, s.groups[0].summary.n);
+}
+
 TEST(StreamedFit, RowWeightsIncludingZeros) {
   const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid");
   SampledRecord r = appendix_a(m);

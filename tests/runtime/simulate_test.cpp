@@ -355,17 +355,22 @@ TEST(Simulate, DerivativeOfAHeldInputIsADiagnostic) {
   }
 }
 
+// A record of output y from a simulation on a uniform grid (its inputs added by the caller).
+SampledRecord record_of(const SimulationSummary& truth, const std::string& path) {
+  SampledRecord record;
+  record.path = path;
+  record.step = truth.time[1] - truth.time[0];
+  record.time = truth.time;
+  record.signals["y"] = truth.outputs[0];
+  return record;
+}
+
 TEST(Validate, ReproducesItsOwnRecordAndReportsDivergence) {
   const ir::Model m = normalized(kThesis);
   const ExplicitForm f = form_of(m);
   SimulateOptions o = thesis_run();
   o.substeps = 10;
-  const auto truth = run(m, f, o);
-  SampledRecord record;
-  record.path = "synthetic.csv";
-  record.step = 0.01;
-  record.time = o.time;
-  record.signals["y"] = truth.outputs[0];
+  SampledRecord record = record_of(run(m, f, o), "synthetic.csv");
   for (double t : o.time) record.signals["x"].push_back(60 * std::sin(4 * M_PI * t));
   ValidationOptions v;
   auto good = validate(m, f, kThesisParameters, record, v);
@@ -421,12 +426,7 @@ TEST(Validate, SolverChosenFromTheEquationsAgreesWithRk4) {
   o.time = grid(0, 40, 0.01);
   o.substeps = 10;
   for (double t : o.time) o.inputs["x"].push_back(std::cos(1.3 * t));
-  const auto truth = run(m, f, o);
-  SampledRecord record;
-  record.path = "duffing.csv";
-  record.step = 0.01;
-  record.time = o.time;
-  record.signals["y"] = truth.outputs[0];
+  SampledRecord record = record_of(run(m, f, o), "duffing.csv");
   record.signals["x"] = o.inputs["x"];
   ValidationOptions rk4, chosen;
   chosen.choose_method = true;

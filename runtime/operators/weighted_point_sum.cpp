@@ -65,14 +65,13 @@ std::optional<Diagnostic> WeightedPointSum::add(double weight, int parameter, co
   part_values_.push_back(0.0);
   term_values_.assign(terms_.size(), 0.0);
   // The padded layout, rebuilt for all terms so far (add() runs a few dozen times per run).
-  width_ = 0;
-  for (const Term& t : terms_) width_ = std::max(width_, t.count);
-  for (const TermFactor& f : factors_)
-    if (f.guard) width_ = 5;
-  if (width_ > 4) {
-    width_ = 0;
-    padded_.clear();
-    return std::nullopt;
+  width_ = 1;
+  exact_terms_.clear();
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const Term& t = terms_[i];
+    const bool guarded = std::any_of(factors_.begin() + t.first, factors_.begin() + t.first + t.count, [](const TermFactor& f) { return f.guard; });
+    if (guarded || t.count > 4) exact_terms_.push_back(i);
+    else width_ = std::max(width_, t.count);
   }
   if (one_ < 0) {
     one_ = static_cast<int>(registers_.size());
@@ -82,7 +81,7 @@ std::optional<Diagnostic> WeightedPointSum::add(double weight, int parameter, co
   coefficients_.clear();
   for (const Term& t : terms_) coefficients_.push_back(t.coefficient);
   for (std::size_t i = 0; i < terms_.size(); ++i)
-    for (int n = 0; n < terms_[i].count; ++n)
+    for (int n = 0; n < terms_[i].count && n < width_; ++n)  // an exact term's own registers unused
       padded_[i * static_cast<std::size_t>(width_) + static_cast<std::size_t>(n)] = factors_[static_cast<std::size_t>(terms_[i].first + n)].reg;
   return std::nullopt;
 }
@@ -134,19 +133,16 @@ double WeightedPointSum::evaluate(const PointInstant& at) {
   for (const Pow& p : pows_) r[p.target] = std::pow(r[p.base], p.exponent);
   double* values = term_values_.data();
   const std::size_t terms = terms_.size();
-  if (width_ > 0) {
-    const double* c = coefficients_.data();
-    switch (width_) {
-      case 1: plain_products<1>(r, padded_.data(), c, terms, values); break;
-      case 2: plain_products<2>(r, padded_.data(), c, terms, values); break;
-      case 3: plain_products<3>(r, padded_.data(), c, terms, values); break;
-      default: plain_products<4>(r, padded_.data(), c, terms, values); break;
-    }
-    for (std::size_t i = 0; i < terms; ++i)
-      if (std::isnan(values[i])) values[i] = exact_term(terms_[i]);
-  } else {
-    for (std::size_t i = 0; i < terms; ++i) values[i] = exact_term(terms_[i]);
+  const double* c = coefficients_.data();
+  switch (width_) {
+    case 1: plain_products<1>(r, padded_.data(), c, terms, values); break;
+    case 2: plain_products<2>(r, padded_.data(), c, terms, values); break;
+    case 3: plain_products<3>(r, padded_.data(), c, terms, values); break;
+    default: plain_products<4>(r, padded_.data(), c, terms, values); break;
   }
+  for (std::size_t i : exact_terms_) values[i] = exact_term(terms_[i]);
+  for (std::size_t i = 0; i < terms; ++i)
+    if (std::isnan(values[i])) values[i] = exact_term(terms_[i]);
   double total = 0;
   for (std::size_t k = 0; k < parts_.size(); ++k) {  // PointSum::sum per part, then the weighted sum
     const Part& part = parts_[k];

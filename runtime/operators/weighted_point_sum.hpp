@@ -86,11 +86,12 @@ class WeightedPointSum {
   std::vector<Term> terms_;
   std::vector<Part> parts_;
   std::vector<double> registers_, part_values_;
-  // Every term without guards, as coefficient * r[a] * r[b] * ... padded to `width_` registers with
-  // one that holds 1 (exact): one plain loop of products, ILP across terms; a NaN product (0 * inf,
-  // which PointSum's guarded product keeps 0) is taken again by exact_term(). width_ 0: the terms
-  // have guards or more than four factors, and go through exact_term() only.
-  int width_ = 0;
+  // Every term as coefficient * r[a] * r[b] * ... padded to `width_` registers with one that holds
+  // 1 (exact): one plain loop of products, ILP across terms; a NaN product (0 * inf, which
+  // PointSum's guarded product keeps 0) is taken again by exact_term(), and so are the terms in
+  // exact_terms_ (a guard, or more than four factors), whose plain product is not used.
+  int width_ = 1;
+  std::vector<std::size_t> exact_terms_;
   int one_ = -1;                   // the register holding 1
   std::vector<int> padded_;        // terms_.size() * width_ registers
   std::vector<double> coefficients_;  // of terms_, contiguous

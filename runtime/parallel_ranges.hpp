@@ -1,11 +1,13 @@
 // Element-wise work over a whole record on every core: [0, n) cut into one contiguous range per
 // thread, each range's elements computed exactly as one thread would (no sum crosses a range), so
 // the values are the same bits on any number of cores. Below `serial_below` units of work the call
-// runs on the caller's thread alone (a thread costs tens of microseconds to start).
+// runs on the caller's thread alone (a thread costs tens of microseconds to start); when no thread
+// can be started, the caller's thread takes the ranges left.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -20,9 +22,15 @@ void for_parallel_ranges(std::size_t n, std::size_t work, F&& f, std::size_t ser
     f(std::size_t{0}, n);
     return;
   }
+  auto range = [&f, n, threads](std::size_t t) { f(n * t / threads, n * (t + 1) / threads); };
   std::vector<std::thread> running;
-  for (std::size_t t = 1; t < threads; ++t) running.emplace_back([&f, n, t, threads] { f(n * t / threads, n * (t + 1) / threads); });
-  f(std::size_t{0}, n / threads);
+  try {
+    running.reserve(threads - 1);
+    for (std::size_t t = 1; t < threads; ++t) running.emplace_back(range, t);
+  } catch (const std::exception&) {  // no thread (or no memory) to be had: the ranges not started run here
+  }
+  range(0);
+  for (std::size_t t = running.size() + 1; t < threads; ++t) range(t);
   for (auto& t : running) t.join();
 }
 

@@ -13,11 +13,15 @@
 
 namespace sidc {
 
+// Threads for work split over the cores: one per core, at most 8 (the streamed fit's, the local
+// fits' and these ranges' default).
+inline int core_count() { return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)); }
+
 // f(first, last) for ranges covering [0, n); `work` is n times the cost of one element, in
 // multiply-adds, say.
 template <class F>
 void for_parallel_ranges(std::size_t n, std::size_t work, F&& f, std::size_t serial_below = std::size_t{1} << 22) {
-  const std::size_t threads = work < serial_below || n < 2 ? 1 : std::min<std::size_t>(n, std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  const std::size_t threads = work < serial_below || n < 2 ? 1 : std::min<std::size_t>(n, static_cast<std::size_t>(core_count()));
   if (threads == 1) {
     f(std::size_t{0}, n);
     return;

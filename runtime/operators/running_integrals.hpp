@@ -47,7 +47,6 @@ class RunningIntegrals {
                                                           const EvaluationOptions& options, FitWindow window,
                                                           const std::vector<const ir::Sum*>& sums);
 
-  bool carried() const { return !prepared_whole_; }
   // The stretch to advance by: `asked` rows (at least 4) when carried, the whole window when not.
   std::size_t stretch_rows(std::size_t asked) const;
 

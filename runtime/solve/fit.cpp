@@ -23,6 +23,7 @@
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/operators/running_integrals.hpp"
+#include "runtime/parallel_ranges.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 #include "runtime/solve/weak_design.hpp"
 
@@ -376,7 +377,7 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
 
 int stream_thread_count(const FitOptions& options) {
   if (options.stream_threads > 0) return options.stream_threads;
-  return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  return core_count();
 }
 
 bool FitOptions::is_valid(std::string* why) const {

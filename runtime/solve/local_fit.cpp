@@ -17,6 +17,7 @@
 #include "runtime/not_a_number.hpp"
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/operators/operator_choice.hpp"
+#include "runtime/parallel_ranges.hpp"
 #include "runtime/solve/design.hpp"
 #include "runtime/solve/sliding_factor.hpp"
 #include "runtime/solve/weak_design.hpp"
@@ -209,7 +210,7 @@ bool is_zero_row(const double* row, int p) {
 int thread_count(const FitOptions& options, const LocalFitOptions& local) {
   const int asked = local.threads > 0 ? local.threads : options.stream_threads;
   if (asked > 0) return asked;
-  return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  return core_count();
 }
 
 // One record's windows for one group, and what the pieces found.

@@ -147,8 +147,14 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
       if (r < g.subdomains.size()) records.back()["weak_subdomains"] = g.subdomains[r];
     }
     ordered_json parameters = ordered_json::array();
-    for (const auto& p : ls.parameters) {
+    for (std::size_t k = 0; k < ls.parameters.size(); ++k) {
+      const auto& p = ls.parameters[k];
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}}});
+      // Newey-West (runtime/solve/hac_covariance.hpp): only where computed, beside the classical ones.
+      if (g.hac.computed && k < g.hac.standard_errors.size()) {
+        parameters.back()["hac_standard_error"] = g.hac.standard_errors[k];
+        parameters.back()["hac_ci95"] = {g.hac.ci_low[k], g.hac.ci_high[k]};
+      }
       // Only for models that give units (docs/language.md, "Units"): other files stay as they were.
       if (const std::string unit = parameter_unit(m, p.name); !unit.empty()) parameters.back()["unit"] = unit;
     }
@@ -182,6 +188,11 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
                                       {"digits_lost_estimate", ls.digits_lost_estimate}}},
                       {"termination", to_string(ls.termination)}, {"message", ls.message}, {"arithmetic", ls.arithmetic},
                       {"dependent_operations", dependent}, {"drift", drift}});
+    if (g.hac.computed)
+      groups.back()["hac"] = {{"bandwidth", g.hac.bandwidth}, {"lag1_autocorrelation", g.hac.lag1_autocorrelation}, {"band99", g.hac.band},
+                              {"prewhitening_clamped", g.hac.prewhitening_clamped}};
+    else if (!g.hac.note.empty())
+      groups.back()["hac"] = {{"note", g.hac.note}};
   }
   j["groups"] = std::move(groups);
   ordered_json noise = ordered_json::array();

@@ -145,7 +145,7 @@ def run_case(sidc, work, config, system, level, seed, timeout):
            "truth_fit_percent": None, "truth_follows": None, "verdict_agrees": None,
            "select_exit": None, "select_error": "", "selected": None, "select_recovered": None,
            "seconds": 0.0, "equation_error_max_rel_error": None, "iv_termination": None, "iv_iterations": None,
-           "refined": None, "covered": None, "intervals": None}
+           "refined": None, "covered": None, "intervals": None, "covered_hac": None}
 
     # 1. the fit of the true terms
     rc, err, secs = run([sidc, "fit", "model.sid", "--out", "fit"] + config.fit_options, d, timeout)
@@ -175,6 +175,14 @@ def run_case(sidc, work, config, system, level, seed, timeout):
         # Coverage: does each true parameter lie in its printed 95% interval?
         held = [ci.get(k) is not None and None not in ci[k] and ci[k][0] <= v <= ci[k][1] for k, v in system.truth.items()]
         row["covered"], row["intervals"] = sum(held), len(held)
+        # The Newey-West intervals of the equation-error fit, where fit.json has them (and no IV or
+        # refinement replaced the estimate): do they hold the truth?
+        hac = {p["name"]: p.get("hac_ci95") for g in fit.get("groups", []) for p in g.get("parameters", [])}
+        if not iv and not (refinement and refinement.get("status") != "failed") and all(hac.get(k) for k in system.truth):
+            held_hac = [None not in hac[k] and hac[k][0] <= v <= hac[k][1] for k, v in system.truth.items()]
+            row["covered_hac"] = sum(held_hac)
+        else:
+            row["covered_hac"] = None
         row["verdict"] = verdict_of(fit)
         outs = [o.get("fit_percent") for r in (fit.get("validation") or {}).get("records", []) for o in r.get("outputs", [])]
         outs = [o if o is not None else float("nan") for o in outs]
@@ -356,7 +364,7 @@ def tables(rows, configs, systems, levels):
 CSV_FIELDS = ["config", "system", "noise", "seed", "fit_exit", "max_rel_error", "worst_parameter", "verdict",
               "validation_fit_percent", "truth_fit_percent", "truth_follows", "verdict_agrees", "select_exit",
               "selected", "select_recovered", "seconds", "fit_error", "select_error", "estimates",
-              "equation_error_max_rel_error", "iv_termination", "iv_iterations", "refined", "covered", "intervals"]
+              "equation_error_max_rel_error", "iv_termination", "iv_iterations", "refined", "covered", "intervals", "covered_hac"]
 
 
 def write_results(out_dir, rows, markdown):

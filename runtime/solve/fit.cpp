@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <limits>
 #include <numeric>
 #include <set>
 #include <thread>
@@ -309,6 +310,7 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
     g.evaluate_seconds += w.evaluate_seconds;
     g.fold_seconds += w.fold_seconds;
   }
+  g.hac.note = "not computed for a streamed fit (its rows are folded into the triangle, not kept)";
   g.streamed = fmt::format("streamed QR over {} rows in blocks of {} rows on {} thread{}", total_rows, block_rows, threads_used,
                            threads_used == 1 ? "" : "s");
   return std::nullopt;
@@ -492,6 +494,15 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     g.drift = find_drift(model, members, g.columns, g.column_parameters, A, b, g.row_equation, g.row_record, g.row_time, paths);
     g.summary = solve_least_squares(A, b, g.columns, g.weighted ? &weights : nullptr, options.least_squares);
     design.label(g.summary);
+    if (!is_static(model)) {  // a static model's rows are observations, not neighbours in time
+      // Neighbouring rows: one record's window for one equation (window_rows' order).
+      std::vector<std::size_t> segments;
+      for (std::size_t i = 0; i < g.row_time.size(); ++i)
+        if (i == 0 || g.row_record[i] != g.row_record[i - 1] || g.row_equation[i] != g.row_equation[i - 1]) segments.push_back(i);
+      HacOptions hac;
+      hac.confidence_level = options.least_squares.confidence_level;
+      g.hac = hac_covariance(A, g.summary.residuals, g.weighted ? &weights : nullptr, segments, g.summary, hac);
+    }
     summary.groups.push_back(std::move(g));
   }
   return summary;
@@ -588,6 +599,33 @@ std::string FitSummary::brief_report() const {
   return out;
 }
 
+namespace {
+
+// The HAC intervals beside the classical ones, and which to trust (hac_covariance.hpp).
+std::string hac_report(const GroupFit& g) {
+  const HacEstimate& h = g.hac;
+  // The weak form has its own note above; an unusable fit says so itself.
+  if (!g.subdomains.empty() || !g.summary.is_solution_usable() || (!h.computed && h.note.empty())) return "";
+  if (!h.computed) return fmt::format("  Newey-West (HAC) intervals: {}\n", h.note);
+  // One rule decides which intervals to trust, the residual analysis' whiteness verdict (its "for the
+  // intervals" line); this section gives the numbers it refers to.
+  std::string out = fmt::format(
+      "  Newey-West (HAC) intervals, which allow for autocorrelated rows (residual lag-1 autocorrelation {:.3g}, 99% band of\n"
+      "  independent rows +-{:.2g}): the ones to trust when the residual analysis below finds the residuals autocorrelated\n"
+      "  (scores prewhitened by an AR(1) each{}, Bartlett kernel of bandwidth {:.1f} rows by Andrews' plug-in)\n",
+      h.lag1_autocorrelation, h.band, h.prewhitening_clamped ? ", its coefficient capped at 0.97" : "", h.bandwidth);
+  out += fmt::format("  {:<14} {:>15}   {:>31}   {}\n", "parameter", "HAC std. error", fmt::format("{:g}% confidence interval", 100 * h.level),
+                     "x classical");
+  for (std::size_t j = 0; j < g.summary.parameters.size() && j < h.standard_errors.size(); ++j) {
+    const auto& p = g.summary.parameters[j];
+    const double ratio = p.standard_error > 0 ? h.standard_errors[j] / p.standard_error : std::numeric_limits<double>::quiet_NaN();
+    out += fmt::format("  {:<14} {:>15.4g}   [{:>13.6g}, {:>13.6g}]   {:.3g}\n", p.name, h.standard_errors[j], h.ci_low[j], h.ci_high[j], ratio);
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string FitSummary::full_report(const ir::Model& model) const {
   std::string out;
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
@@ -627,6 +665,7 @@ std::string FitSummary::full_report(const ir::Model& model) const {
       out += fmt::format("  {:<14} {:>15.6g} {:>13.4g}   [{:>13.6g}, {:>13.6g}]{}\n", p.name, p.value, p.standard_error, p.ci_low,
                          p.ci_high, unit.empty() ? "" : "   " + unit);
     }
+    out += hac_report(g);
     if (g.weighted && model.weights)
       out += fmt::format("  residuals weighted by `{}` (eq. 2-1.6)\n", print(model.weights->value));
     else if (g.weighted)

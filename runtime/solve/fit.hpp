@@ -29,6 +29,7 @@
 #include "runtime/operators/operator_choice.hpp"
 #include "runtime/solve/design.hpp"
 #include "runtime/solve/drift_check.hpp"
+#include "runtime/solve/hac_covariance.hpp"
 #include "runtime/solve/least_squares.hpp"
 
 namespace sidc {
@@ -88,6 +89,9 @@ struct GroupFit {
   std::vector<double> row_time;
   std::vector<double> known;  // the right-hand side per row
   std::vector<DriftFinding> drift;  // integrated equations dominated by drift (drift_check.hpp; dense fits only)
+  // Intervals honest under autocorrelated rows (hac_covariance.hpp): dense fits of dynamic models in
+  // the derivative and integrated forms; `note` says why not for the others.
+  HacEstimate hac;
   // Empty for a dense fit; for a streamed one, how (printed in the report), e.g. "streamed QR over
   // 9999988 rows in blocks of 2048 rows on 2 threads", and the per-row vectors above are empty.
   std::string streamed;

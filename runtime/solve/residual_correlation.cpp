@@ -332,6 +332,11 @@ std::string ResidualCorrelationSummary::brief_report() const {
   text += fmt::format("  autocorrelation: {}\n", autocorrelation.verdict);
   for (const auto& curve : cross) text += fmt::format("  cross-correlation with `{}`: {}\n", curve.name, curve.verdict);
   text += "  verdict: " + verdict + "\n";
+  // What the whiteness verdict means for the fit's intervals (issue 15, item 4).
+  text += autocorrelation.white
+              ? "  for the intervals: the classical ones assume independent rows, and the residuals do not contradict it\n"
+              : "  for the intervals: the classical ones assume independent rows and are too narrow here; trust the Newey-West\n"
+                "  (HAC) ones where the fit report gives them (docs/accuracy.md, \"Intervals under autocorrelated rows\")\n";
   return text;
 }
 

@@ -248,9 +248,17 @@ nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSu
     for (const auto& p : g.parameters) {
       parameters.push_back({{"name", p.name}, {"estimate", p.value}, {"standard_error", p.standard_error}, {"ci95", {p.ci_low, p.ci_high}},
                             {"equation_error_estimate", p.equation_error}});
+      if (g.hac) {
+        parameters.back()["hac_standard_error"] = p.hac_standard_error;
+        parameters.back()["hac_ci95"] = {p.hac_ci_low, p.hac_ci_high};
+      }
       if (!p.unit.empty()) parameters.back()["unit"] = p.unit;
     }
     groups.push_back({{"form", g.form}, {"n", g.n}, {"p", g.p}, {"residual_sd", g.residual_sd}, {"parameters", std::move(parameters)}});
+    if (g.hac)
+      groups.back()["hac"] = {{"bandwidth", g.hac_bandwidth}, {"lag1_autocorrelation", g.lag1}, {"band99", g.band}};
+    else if (!g.hac_note.empty())
+      groups.back()["hac"] = {{"note", g.hac_note}};
   }
   return {{"termination", to_string(iv.termination)}, {"statement", iv.statement}, {"iterations", iv.iterations},
           {"max_iterations", iv.max_iterations}, {"tolerance", iv.tolerance}, {"changes", iv.changes},

@@ -175,10 +175,11 @@ def run_case(sidc, work, config, system, level, seed, timeout):
         # Coverage: does each true parameter lie in its printed 95% interval?
         held = [ci.get(k) is not None and None not in ci[k] and ci[k][0] <= v <= ci[k][1] for k, v in system.truth.items()]
         row["covered"], row["intervals"] = sum(held), len(held)
-        # The Newey-West intervals of the equation-error fit, where fit.json has them (and no IV or
-        # refinement replaced the estimate): do they hold the truth?
-        hac = {p["name"]: p.get("hac_ci95") for g in fit.get("groups", []) for p in g.get("parameters", [])}
-        if not iv and not (refinement and refinement.get("status") != "failed") and all(hac.get(k) for k in system.truth):
+        # The Newey-West intervals of the estimate judged (IV's or the equation-error fit's), where
+        # fit.json has them and no refinement replaced it: do they hold the truth?
+        hac_groups = iv["groups"] if iv and iv.get("groups") else fit.get("groups", [])
+        hac = {p["name"]: p.get("hac_ci95") for g in hac_groups for p in g.get("parameters", [])}
+        if not (refinement and refinement.get("status") != "failed") and all(hac.get(k) for k in system.truth):
             held_hac = [None not in hac[k] and hac[k][0] <= v <= hac[k][1] for k, v in system.truth.items()]
             row["covered_hac"] = sum(held_hac)
         else:

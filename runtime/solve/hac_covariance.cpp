@@ -27,7 +27,7 @@ MatrixXd lagged_products(const MatrixXd& x, const MatrixXd& y, const std::vector
 }
 
 // Bartlett-weighted long-run covariance of the rows of u: sum over |l| < S of (1 - |l|/S) Gamma_l.
-MatrixXd long_run_covariance(const MatrixXd& u, const std::vector<Segment>& segments, double S) {
+MatrixXd bartlett_sum(const MatrixXd& u, const std::vector<Segment>& segments, double S) {
   MatrixXd omega = lagged_products(u, u, segments, 0);
   for (Index l = 1; static_cast<double>(l) < S; ++l) {
     const MatrixXd gamma = lagged_products(u, u, segments, l);
@@ -64,29 +64,40 @@ double andrews_bandwidth(const MatrixXd& u, const std::vector<Segment>& segments
   return std::max(1.0, 1.1447 * std::cbrt(numerator / denominator * T));
 }
 
-}  // namespace
-
-HacEstimate hac_covariance(const MatrixXd& A, const std::vector<double>& residuals, const Eigen::VectorXd* weights,
-                           const std::vector<std::size_t>& segment_starts, const LeastSquaresSummary& summary, const HacOptions& options) {
-  HacEstimate out;
-  out.level = options.confidence_level;
-  const Index n = A.rows(), p = A.cols();
-  if (!summary.is_solution_usable()) {
-    out.note = "the fit is not usable";
-    return out;
-  }
-  if (static_cast<Index>(residuals.size()) != n || p == 0 || summary.parameters.size() != static_cast<std::size_t>(p) ||
-      summary.covariance.rows() != p || !summary.covariance.allFinite() || !(summary.residual_sd > 0)) {
-    out.note = "the classical covariance has no finite value to start from";
-    return out;
-  }
+std::vector<Segment> segments_of(const std::vector<std::size_t>& segment_starts, Index n) {
   std::vector<Segment> segments;
   for (std::size_t k = 0; k < segment_starts.size(); ++k) {
     const auto first = static_cast<Index>(segment_starts[k]);
     const Index last = k + 1 < segment_starts.size() ? static_cast<Index>(segment_starts[k + 1]) : n;
     if (last > first) segments.push_back({first, last - first});
   }
-  if (segments.empty()) {
+  return segments;
+}
+
+}  // namespace
+
+// The lag-1 autocorrelation of e, each segment's mean removed, pooled over segments.
+double lag1_autocorrelation(const std::vector<double>& e, const std::vector<std::size_t>& segment_starts) {
+  const std::vector<Segment> segments = segments_of(segment_starts, static_cast<Index>(e.size()));
+  double c0 = 0, c1 = 0;
+  for (const auto& s : segments) {
+    double mean = 0;
+    for (Index t = s.first; t < s.first + s.rows; ++t) mean += e[static_cast<std::size_t>(t)];
+    mean /= static_cast<double>(s.rows);
+    for (Index t = s.first; t < s.first + s.rows; ++t) {
+      const double x = e[static_cast<std::size_t>(t)] - mean;
+      c0 += x * x;
+      if (t > s.first) c1 += x * (e[static_cast<std::size_t>(t - 1)] - mean);
+    }
+  }
+  return c0 > 0 ? c1 / c0 : 0.0;
+}
+
+LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vector<std::size_t>& segment_starts, double max_work) {
+  LongRunCovariance out;
+  const Index n = raw_scores.rows(), p = raw_scores.cols();
+  const std::vector<Segment> segments = segments_of(segment_starts, n);
+  if (segments.empty() || p == 0) {
     out.note = "no rows";
     return out;
   }
@@ -97,39 +108,14 @@ HacEstimate hac_covariance(const MatrixXd& A, const std::vector<double>& residua
     out.note = fmt::format("too few rows per record and equation ({:.0f}) for {} parameters", T, p);
     return out;
   }
-
-  // The scores s_i = w_i^2 r_i a_i, each column scaled to unit mean square.
-  MatrixXd scores(n, p);
-  std::vector<double> weighted(static_cast<std::size_t>(n));
-  for (Index i = 0; i < n; ++i) {
-    const double w = weights ? (*weights)(i) : 1.0;
-    weighted[static_cast<std::size_t>(i)] = w * residuals[static_cast<std::size_t>(i)];
-    scores.row(i) = (w * w * residuals[static_cast<std::size_t>(i)]) * A.row(i);
-  }
-  Eigen::VectorXd scale = (scores.colwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt().transpose();
+  // Each column scaled to unit mean square (mapped back at the end).
+  Eigen::VectorXd scale = (raw_scores.colwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt().transpose();
   for (Index j = 0; j < p; ++j)
     if (!(scale(j) > 0) || !std::isfinite(scale(j))) scale(j) = 1;
-  scores = scores * scale.cwiseInverse().asDiagonal();
+  const MatrixXd scores = raw_scores * scale.cwiseInverse().asDiagonal();
   if (!scores.allFinite()) {
     out.note = "a score is not finite";
     return out;
-  }
-
-  // The residuals' own lag-1 autocorrelation (segments mean-removed): the verdict on independence.
-  {
-    double c0 = 0, c1 = 0;
-    for (const auto& s : segments) {
-      double mean = 0;
-      for (Index t = s.first; t < s.first + s.rows; ++t) mean += weighted[static_cast<std::size_t>(t)];
-      mean /= static_cast<double>(s.rows);
-      for (Index t = s.first; t < s.first + s.rows; ++t) {
-        const double e = weighted[static_cast<std::size_t>(t)] - mean;
-        c0 += e * e;
-        if (t > s.first) c1 += e * (weighted[static_cast<std::size_t>(t - 1)] - mean);
-      }
-    }
-    out.lag1_autocorrelation = c0 > 0 ? c1 / c0 : 0.0;
-    out.band = 2.576 / std::sqrt(static_cast<double>(n));
   }
 
   // AR(1) prewhitening, column by column: u_t = s_t - rho s_{t-1}, |rho| at most 0.97. One
@@ -164,20 +150,54 @@ HacEstimate hac_covariance(const MatrixXd& A, const std::vector<double>& residua
   u.conservativeResize(row, p);
 
   out.bandwidth = std::min(andrews_bandwidth(u, whitened_segments, T - 1), T - 1);
-  if (static_cast<double>(n) * static_cast<double>(p * p) * out.bandwidth > options.max_work) {
+  if (static_cast<double>(n) * static_cast<double>(p * p) * out.bandwidth > max_work) {
     out.note = fmt::format("not computed: {} rows, {} parameters and {:.0f} lags are beyond its work limit", n, p, out.bandwidth);
     return out;
   }
-  const MatrixXd omega_u = long_run_covariance(u, whitened_segments, out.bandwidth);
-  const Eigen::VectorXd recolour = (Eigen::VectorXd::Ones(p) - rho).cwiseInverse();
+  const MatrixXd omega_u = bartlett_sum(u, whitened_segments, out.bandwidth);
+  const Eigen::VectorXd recolour = (Eigen::VectorXd::Ones(p) - rho).cwiseInverse().cwiseProduct(scale);
+  out.omega = recolour.asDiagonal() * omega_u * recolour.asDiagonal();
+  out.computed = out.omega.allFinite();
+  if (!out.computed) out.note = "the long-run covariance is not finite";
+  return out;
+}
+
+HacEstimate hac_covariance(const MatrixXd& A, const std::vector<double>& residuals, const Eigen::VectorXd* weights,
+                           const std::vector<std::size_t>& segment_starts, const LeastSquaresSummary& summary, const HacOptions& options) {
+  HacEstimate out;
+  out.level = options.confidence_level;
+  const Index n = A.rows(), p = A.cols();
+  if (!summary.is_solution_usable()) {
+    out.note = "the fit is not usable";
+    return out;
+  }
+  if (static_cast<Index>(residuals.size()) != n || p == 0 || summary.parameters.size() != static_cast<std::size_t>(p) ||
+      summary.covariance.rows() != p || !summary.covariance.allFinite() || !(summary.residual_sd > 0)) {
+    out.note = "the classical covariance has no finite value to start from";
+    return out;
+  }
+  // The scores s_i = w_i^2 r_i a_i, and the weighted residuals w_i r_i.
+  MatrixXd scores(n, p);
+  std::vector<double> weighted(static_cast<std::size_t>(n));
+  for (Index i = 0; i < n; ++i) {
+    const double w = weights ? (*weights)(i) : 1.0;
+    weighted[static_cast<std::size_t>(i)] = w * residuals[static_cast<std::size_t>(i)];
+    scores.row(i) = (w * w * residuals[static_cast<std::size_t>(i)]) * A.row(i);
+  }
+  out.lag1_autocorrelation = lag1_autocorrelation(weighted, segment_starts);
+  out.band = 2.576 / std::sqrt(static_cast<double>(n));
+  const LongRunCovariance omega = long_run_covariance(scores, segment_starts, options.max_work);
+  out.bandwidth = omega.bandwidth;
+  out.prewhitening_clamped = omega.prewhitening_clamped;
+  if (!omega.computed) {
+    out.note = omega.note;
+    return out;
+  }
   const double dof = static_cast<double>(summary.n) - static_cast<double>(summary.rank);
   const double small_sample = dof > 0 ? static_cast<double>(n) / dof : 1.0;
-  MatrixXd omega = small_sample * (recolour.asDiagonal() * omega_u * recolour.asDiagonal());
-  omega = scale.asDiagonal() * omega * scale.asDiagonal();  // back to the scores' units
-
   const double sigma2 = summary.residual_sd * summary.residual_sd;
   const MatrixXd bread = summary.covariance / sigma2;  // (A^T W^2 A)^-1
-  out.covariance = bread * omega * bread;
+  out.covariance = small_sample * (bread * omega.omega * bread);
   if (!out.covariance.allFinite()) {
     out.note = "the sandwich is not finite";
     return out;

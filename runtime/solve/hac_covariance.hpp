@@ -60,6 +60,22 @@ struct HacEstimate {
   bool prewhitening_clamped = false;    // an AR(1) coefficient was brought down to 0.97
 };
 
+// The long-run covariance sum_l Gamma_l of a series of score rows (n x p), as the sandwich's middle:
+// AR(1)-prewhitened column by column, Bartlett kernel, Andrews' bandwidth, lags within segments.
+// Shared by the least-squares sandwich below and instrumental variables' (scores z_i w_i^2 e_i).
+struct LongRunCovariance {
+  bool computed = false;
+  std::string note;          // why not computed
+  Eigen::MatrixXd omega;     // p x p, in the scores' units
+  double bandwidth = 0;
+  bool prewhitening_clamped = false;
+};
+LongRunCovariance long_run_covariance(const Eigen::MatrixXd& scores, const std::vector<std::size_t>& segment_starts,
+                                      double max_work = HacOptions{}.max_work);
+
+// The lag-1 autocorrelation of e, each segment's mean removed, pooled over the segments.
+double lag1_autocorrelation(const std::vector<double>& e, const std::vector<std::size_t>& segment_starts);
+
 // The sandwich for the solved least-squares problem min sum (w_i (b_i - A_i x))^2. `residuals` are
 // the unweighted b_i - A_i x (LeastSquaresSummary::residuals); `weights` may be null (all 1);
 // `segment_starts` are the first rows of the runs of neighbouring rows (0 first, increasing).

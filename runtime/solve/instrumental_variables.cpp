@@ -5,6 +5,8 @@
 // Boost.Math (Student t). Guarantees: the header's.
 #include "runtime/solve/instrumental_variables.hpp"
 
+#include "runtime/solve/hac_covariance.hpp"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -138,6 +140,9 @@ struct IvSolution {
   std::string problem;  // empty when solved
   VectorXd theta;
   MatrixXd covariance;
+  MatrixXd hac_covariance;  // Newey-West (hac_covariance.hpp); empty when not computed, hac_note says why
+  std::string hac_note;
+  double hac_bandwidth = 0, lag1 = 0, band = 0;  // the IV residuals' lag-1 autocorrelation and its 99% band
   std::size_t n = 0;
   double residual_sd = 0;
 };
@@ -152,7 +157,12 @@ struct IvSolution {
 // from M's own factor like least squares' sigma^2 (R^T R)^-1; sigma^2 = |w (b - Phi theta)|^2 / (n - p).
 // With Z = Phi the solution is the least-squares one. Double precision: the record's noise, not
 // the arithmetic, limits an IV estimate.
-IvSolution solve_iv(const MatrixXd& A, const VectorXd& b, const MatrixXd& Z, const VectorXd& w, const std::vector<std::string>& names) {
+//
+// The Newey-West covariance, when `segment_starts` (the first rows of the runs of neighbouring rows)
+// is given: (Z^T W^2 Phi)^-1 Omega (Phi^T W^2 Z)^-1 with Omega the long-run covariance of the scores
+// w_i^2 e_i z_i (hac_covariance.hpp) and the small-sample factor n / (n - p); Z's column scales cancel.
+IvSolution solve_iv(const MatrixXd& A, const VectorXd& b, const MatrixXd& Z, const VectorXd& w, const std::vector<std::string>& names,
+                    const std::vector<std::size_t>* segment_starts) {
   IvSolution s;
   const Index p = A.cols();
   std::vector<Index> kept;
@@ -213,6 +223,36 @@ IvSolution solve_iv(const MatrixXd& A, const VectorXd& b, const MatrixXd& Z, con
   for (Index i = 0; i < p; ++i)
     for (Index j = 0; j < p; ++j) unpivoted(perm(i), perm(j)) = pivoted(i, j);
   s.covariance = variance * (sa.asDiagonal() * unpivoted * sa.asDiagonal());
+  if (!segment_starts) return s;
+  // The kept rows' segments: a run starts where a given segment starts, or after a dropped row.
+  std::vector<std::size_t> segment_of(static_cast<std::size_t>(A.rows()), 0);
+  for (std::size_t i = 0, id = 0, next = 0; i < segment_of.size(); ++i) {
+    while (next < segment_starts->size() && (*segment_starts)[next] <= i) ++id, ++next;
+    segment_of[i] = id;
+  }
+  std::vector<std::size_t> starts;
+  for (Index k = 0; k < n; ++k) {
+    const auto i = static_cast<std::size_t>(kept[static_cast<std::size_t>(k)]);
+    const auto before = k > 0 ? static_cast<std::size_t>(kept[static_cast<std::size_t>(k - 1)]) : i;
+    if (k == 0 || before + 1 != i || segment_of[before] != segment_of[i]) starts.push_back(static_cast<std::size_t>(k));
+  }
+  const VectorXd e = bw - Aw * u;
+  s.lag1 = lag1_autocorrelation(std::vector<double>(e.data(), e.data() + e.size()), starts);
+  s.band = 2.576 / std::sqrt(static_cast<double>(n));
+  const MatrixXd scores = e.asDiagonal() * Zw;
+  const LongRunCovariance omega = long_run_covariance(scores, starts);
+  s.hac_bandwidth = omega.bandwidth;
+  if (!omega.computed) {
+    s.hac_note = omega.note;
+    return s;
+  }
+  const MatrixXd bread = (Zw.transpose() * Aw).inverse();  // (Z^T W^2 Phi)^-1, scaled coordinates
+  const MatrixXd scaled = static_cast<double>(n) / static_cast<double>(n - p) * (bread * omega.omega * bread.transpose());
+  s.hac_covariance = sa.asDiagonal() * scaled * sa.asDiagonal();
+  if (!s.hac_covariance.allFinite()) {
+    s.hac_covariance.resize(0, 0);
+    s.hac_note = "the sandwich is not finite";
+  }
   return s;
 }
 
@@ -328,11 +368,26 @@ std::string InstrumentalVariablesSummary::full_report() const {
   for (std::size_t g = 0; g < groups.size(); ++g)
     out += fmt::format("  {}n = {}, p = {}, residual s.d. of the IV residuals b - Phi theta = {:.4g}\n",
                        groups.size() > 1 ? fmt::format("group {}: ", g + 1) : std::string(), groups[g].n, groups[g].p, groups[g].residual_sd);
-  // The intervals treat the rows as independent; where the form makes them dependent, what was measured (docs/accuracy.md).
+  // The intervals above treat the rows as independent; the Newey-West ones allow for autocorrelated
+  // rows, and the IV residuals' lag-1 autocorrelation says which to trust (docs/accuracy.md).
   const auto has = [&](const char* form) { return std::any_of(groups.begin(), groups.end(), [&](const auto& g) { return g.form == form; }); };
-  if (iterations > 0 && has("integrated"))
-    out += "  (integrated equations' rows share the noise their integrals gather, so these intervals, those of independent rows,\n"
-           "  are too narrow: they held the truth for about half the parameters of known-truth records (docs/accuracy.md))\n";
+  for (std::size_t gi = 0; gi < groups.size() && iterations > 0; ++gi) {
+    const auto& g = groups[gi];
+    const std::string which = groups.size() > 1 ? fmt::format(" (group {})", gi + 1) : std::string();
+    if (!g.hac) {
+      if (!g.hac_note.empty()) out += fmt::format("  Newey-West (HAC) intervals{}: not computed: {}\n", which, g.hac_note);
+      continue;
+    }
+    const bool correlated = std::abs(g.lag1) > g.band;
+    out += fmt::format("  Newey-West (HAC) intervals{}, which allow for autocorrelated rows (Bartlett kernel of bandwidth {:.1f} rows);\n"
+                       "  the IV residuals' lag-1 autocorrelation is {:.3g}, {} the 99% band +-{:.2g} of independent rows:\n  {}\n",
+                       which, g.hac_bandwidth, g.lag1, correlated ? "outside" : "inside", g.band,
+                       correlated ? "the intervals above are too narrow, trust these" : "the intervals above hold their assumption");
+    out += fmt::format("  {:<14} {:>15}   {:>31}   {}\n", "parameter", "HAC std. error", "95% confidence interval", "x IV's");
+    for (const auto& p : g.parameters)
+      out += fmt::format("  {:<14} {:>15.4g}   [{:>13.6g}, {:>13.6g}]   {:.3g}\n", p.name, p.hac_standard_error, p.hac_ci_low, p.hac_ci_high,
+                         p.standard_error > 0 ? p.hac_standard_error / p.standard_error : std::numeric_limits<double>::quiet_NaN());
+  }
   if (iterations > 0 && has("weak"))
     out += "  (neighbouring subdomains overlap, so the rows are not independent; these intervals held the truth for 89-96% of the\n"
            "  parameters of known-truth records (docs/accuracy.md))\n";
@@ -439,7 +494,14 @@ InstrumentalVariablesSummary instrumental_variables(const ir::Model& model, cons
         problem = "its instruments could not be evaluated: " + *bad;
         break;
       }
-      IvSolution solution = solve_iv(groups[g].A, groups[g].b, Z, groups[g].weights, fitted.groups[g].columns);
+      // Neighbouring rows (one record's window of one equation) for the Newey-West intervals; not
+      // for the weak form, whose rows are overlapping subdomains (docs/accuracy.md).
+      std::vector<std::size_t> segments;
+      const GroupFit& fg = fitted.groups[g];
+      for (std::size_t i = 0; i < fg.row_record.size(); ++i)
+        if (i == 0 || fg.row_record[i] != fg.row_record[i - 1] || fg.row_equation[i] != fg.row_equation[i - 1]) segments.push_back(i);
+      const bool with_hac = !groups[g].weak && fg.row_record.size() == static_cast<std::size_t>(groups[g].A.rows());
+      IvSolution solution = solve_iv(groups[g].A, groups[g].b, Z, groups[g].weights, fitted.groups[g].columns, with_hac ? &segments : nullptr);
       if (!solution.problem.empty()) {
         problem = solution.problem;
         break;
@@ -485,7 +547,14 @@ InstrumentalVariablesSummary instrumental_variables(const ir::Model& model, cons
     const double t = t_quantile(0.5 + iv_options.confidence_level / 2, static_cast<double>(out.n) - static_cast<double>(out.p));
     for (std::size_t c = 0; c < ee.parameters.size(); ++c) {
       const ParameterEstimate& e = ee.parameters[c];
-      InstrumentalVariablesParameter p{e.name, e.index, e.value, e.standard_error, e.ci_low, e.ci_high, e.value, parameter_unit(model, e.name)};
+      InstrumentalVariablesParameter p;
+      p.name = e.name;
+      p.index = e.index;
+      p.value = p.equation_error = e.value;
+      p.standard_error = e.standard_error;
+      p.ci_low = e.ci_low;
+      p.ci_high = e.ci_high;
+      p.unit = parameter_unit(model, e.name);
       if (k > 0) {
         const auto i = static_cast<Index>(c);
         p.value = current[g](i);
@@ -493,8 +562,20 @@ InstrumentalVariablesSummary instrumental_variables(const ir::Model& model, cons
         p.standard_error = variance >= 0 ? std::sqrt(variance) : std::numeric_limits<double>::quiet_NaN();
         p.ci_low = p.value - t * p.standard_error;
         p.ci_high = p.value + t * p.standard_error;
+        if (solutions[g].hac_covariance.size() > 0) {
+          p.hac_standard_error = std::sqrt(std::max(0.0, solutions[g].hac_covariance(i, i)));
+          p.hac_ci_low = p.value - t * p.hac_standard_error;
+          p.hac_ci_high = p.value + t * p.hac_standard_error;
+        }
       }
       out.parameters.push_back(std::move(p));
+    }
+    if (k > 0) {
+      out.hac = solutions[g].hac_covariance.size() > 0;
+      out.hac_bandwidth = solutions[g].hac_bandwidth;
+      out.lag1 = solutions[g].lag1;
+      out.band = solutions[g].band;
+      out.hac_note = groups[g].weak ? "" : solutions[g].hac_note;
     }
     s.groups.push_back(std::move(out));
   }

@@ -27,6 +27,7 @@
 // group is said to be out of reach).
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <variant>
@@ -53,6 +54,9 @@ struct InstrumentalVariablesParameter {
   std::optional<ParameterIndex> index;
   double value = 0, standard_error = 0, ci_low = 0, ci_high = 0;
   double equation_error = 0;  // the equation-error (least-squares) estimate, for comparison
+  // Newey-West (HAC) standard error and interval (hac_covariance.hpp), which allow for
+  // autocorrelated rows; NaN where the group's `hac_note` says why not.
+  double hac_standard_error = std::numeric_limits<double>::quiet_NaN(), hac_ci_low = hac_standard_error, hac_ci_high = hac_standard_error;
   std::string unit;           // as the fit table prints it; "" when the model gives none
 };
 
@@ -61,6 +65,10 @@ struct InstrumentalVariablesGroup {
   std::vector<InstrumentalVariablesParameter> parameters;  // in the fit's column order
   std::size_t n = 0, p = 0;     // rows with non-zero weight, columns
   double residual_sd = 0;       // sqrt(sum (w (b - Phi theta))^2 / (n - p))
+  bool hac = false;             // the parameters' HAC intervals computed
+  double hac_bandwidth = 0;
+  double lag1 = 0, band = 0;    // the IV residuals' lag-1 autocorrelation, and its 99% band 2.576/sqrt(n)
+  std::string hac_note;         // why not, when not
 };
 
 struct InstrumentalVariablesSummary {

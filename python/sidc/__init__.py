@@ -107,7 +107,7 @@ class Model:
 
 class FitResult:
     """One fit. `estimates`, `standard_errors`, `ci95`: dicts by parameter name (integration
-    constants too, as fit.json lists them); `covariance`: a numpy matrix in the order of
+    constants too, as fit.json lists them); `hac_ci95`: the Newey-West intervals where computed; `covariance`: a numpy matrix in the order of
     `estimates`; `G`: the sum of squared equation errors over the groups (eq. 2-1.7);
     `statistics`: one dict per equation group (fit.json's); `validation`: fit.json's (None with
     no_validate); `residuals`: dict of numpy arrays (residuals.csv's columns); `report()`: what
@@ -172,6 +172,13 @@ class FitResult:
     @property
     def ci95(self):
         return {p["name"]: tuple(_number(x) for x in p["ci95"]) for p in self._parameters()}
+
+    @property
+    def hac_ci95(self):
+        """The Newey-West (HAC) 95% intervals, which allow for autocorrelated rows, by parameter name,
+        where the fit computed them (dense derivative- and integrated-form fits: docs/accuracy.md,
+        "Intervals under autocorrelated rows"); the residual analysis says which intervals to trust."""
+        return {p["name"]: tuple(_number(x) for x in p["hac_ci95"]) for p in self._parameters() if "hac_ci95" in p}
 
     @property
     def covariance(self):

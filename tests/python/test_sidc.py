@@ -97,6 +97,9 @@ class FitAgreesWithCli(Workspace):
         self.assertEqual(list(result.estimates), names)
         self.assertEqual(result.standard_errors["m"], group["parameters"][0]["standard_error"])
         self.assertEqual(result.ci95["m"], tuple(group["parameters"][0]["ci95"]))
+        # 80 rows for 14 parameters: too few for Newey-West intervals, and fit.json says why.
+        self.assertEqual(result.hac_ci95, {})
+        self.assertIn("too few rows", group["hac"]["note"])
         self.assertEqual(result.covariance.shape, (len(names), len(names)))
         np.testing.assert_array_equal(result.covariance, np.array(group["covariance"], dtype=float))
         self.assertEqual(result.G, group["statistics"]["G"])

@@ -41,6 +41,7 @@ struct FitArguments {
   std::vector<std::string> validate;  // further records, not used in fitting
   std::size_t validate_samples = 0;       // compared at most per record (0 = all)
   std::size_t refine_samples = 100000;    // fitted by --refine at most per record (0 = all)
+  int refine_segments = 0;                // --refine's shooting segments per record (0 = chosen from the data)
   std::string initial_state = "estimate";  // the validation's start: estimated, or read from the record
   std::string plots;                  // --plots DIR
   std::string report;                 // --report FILE.html
@@ -77,6 +78,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   settings.validate.assign(a.validate.begin(), a.validate.end());
   settings.validate_samples = a.validate_samples;
   settings.refine_samples = a.refine_samples;
+  settings.refine_segments = a.refine_segments;
   settings.initial_state = a.initial_state == "record" ? InitialState::record : InitialState::estimate;
   settings.refine = a.refine;
   settings.estimator = a.estimator;
@@ -165,8 +167,13 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   add_record_options(cmd, a->records);
   add_form_options(cmd, a->form_options);
   cmd->add_option("--out", a->out, "Directory for fit.json, residuals.csv, validation.csv and (with --local or --forget) local.csv");
-  cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all, the default)");
-  cmd->add_option("--refine-samples", a->refine_samples, "Samples of each record the refinement (--refine) fits at most, from the start (default 100000; 0 = all)");
+  cmd->add_option("--validate-samples", a->validate_samples, "Samples of each record compared by simulation at most, from the start (0 = all, the default)")
+      ->check(whole_number_check(0));
+  cmd->add_option("--refine-samples", a->refine_samples, "Samples of each record the refinement (--refine) fits at most, from the start (default 100000; 0 = all)")
+      ->check(whole_number_check(0));
+  cmd->add_option("--refine-segments", a->refine_segments,
+                  "Shooting segments per record for --refine: 1 = single shooting, N = multiple shooting over N segments, 0 = single unless the start's solution diverges (default)")
+      ->check(whole_number_check(0));
   cmd->add_option("--initial-state", a->initial_state,
                   "The validation's initial state: `estimate` (least squares over the record's start, the default) or `record` "
                   "(the first sample and its moving-arc derivatives)")
@@ -182,7 +189,7 @@ void add_fit_command(CLI::App& app, int& exit_status) {
                   "(thesis chapter V); writes local.csv with --out, a picture per parameter with --plots")
       ->check(number_check("WIDTH", [](double v) { return std::isfinite(v) && v > 0; },
                            "WIDTH must be a positive, finite number of time units, e.g. 2.5"));
-  cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(CLI::PositiveNumber);
+  cmd->add_option("--stride", a->stride, "Samples from one local window to the next (default 1: every sample)")->check(whole_number_check(1));
   cmd->add_option("--forget", a->forget,
                   "Local estimates by exponential forgetting instead of windows: each sample's rows weighted lambda^age, "
                   "0 < LAMBDA < 1 (memory about 1/(1 - LAMBDA) samples)")

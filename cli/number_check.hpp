@@ -23,4 +23,18 @@ inline CLI::Validator number_check(const std::string& name, bool (*holds)(double
       name);
 }
 
+// A whole-number option of at least `least`: "-1" for a count is refused (CLI11 reads it into an
+// unsigned type as 2^64 - 1), and so are "2.5", "1e3" and "inf", each with sidc's message.
+inline CLI::Validator whole_number_check(long long least) {
+  return CLI::Validator(
+      [least](std::string& text) -> std::string {
+        long long v = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (ec == std::errc() && end == text.data() + text.size() && v >= least) return {};
+        return least == 0 ? fmt::format("`{}` is not a whole number of 0 or more", text)
+                          : fmt::format("`{}` is not a whole number of {} or more", text, least);
+      },
+      least == 0 ? "NONNEGATIVE" : least == 1 ? "POSITIVE" : fmt::format("AT LEAST {}", least));
+}
+
 }  // namespace sidc

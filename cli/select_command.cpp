@@ -12,6 +12,7 @@
 #include <iostream>
 
 #include "cli/exit_codes.hpp"
+#include "cli/number_check.hpp"
 #include "cli/output_check.hpp"
 #include "cli/progress_line.hpp"
 #include "cli/record_options.hpp"
@@ -124,7 +125,8 @@ void add_select_command(CLI::App& app, int& exit_status) {
   cmd->add_option("--bootstrap", a->bootstrap, "Bootstrap replicates over time blocks (0 = off)")->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", a->seed, "Seed of the bootstrap's random draws");
   cmd->add_flag("--simulate", a->simulate, "Also rank the sizes by the RMS error of the best subset's solution against the record (thesis section 2-4)");
-  cmd->add_option("--simulate-samples", a->simulate_samples, "Samples of each record compared by --simulate at most (0 = all)");
+  cmd->add_option("--simulate-samples", a->simulate_samples, "Samples of each record compared by --simulate at most (0 = all)")
+      ->check(whole_number_check(0));
   cmd->add_option("--max-size", a->max_size, "Largest subset size reported")->check(CLI::Range(0, 10000));
   cmd->add_option("--rule", a->rule, "Criterion naming the non-contributory operations: elbow (default: the relative-G elbow, or CV's choice when smaller), cv, bic or aic")
       ->check(CLI::IsMember({"elbow", "aic", "bic", "cv"}));

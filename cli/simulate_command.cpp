@@ -19,6 +19,7 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/fitted_values.hpp"
+#include "cli/number_check.hpp"
 #include "cli/output_check.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
@@ -281,7 +282,7 @@ void add_simulate_command(CLI::App& app, int& exit_status) {
       ->allow_extra_args(false)
       ->delimiter(',');
   cmd->add_option("--data", a->data, "Record giving the time grid, the inputs and the initial state (default: the model's data statement)");
-  cmd->add_option("--every", a->every, "Keep every K-th sample of the record")->check(CLI::PositiveNumber);
+  cmd->add_option("--every", a->every, "Keep every K-th sample of the record")->check(whole_number_check(1));
   cmd->add_option("--t0", a->t0, "Start time (default: the record's first sample, or 0)");
   cmd->add_option("--t1", a->t1, "End time (default: the record's last sample)");
   cmd->add_option("--step", a->step, "Output step, for a run without a record")->check(CLI::PositiveNumber);
@@ -290,7 +291,7 @@ void add_simulate_command(CLI::App& app, int& exit_status) {
       ->delimiter(',');
   cmd->add_option("--method", a->method, "rk4 (fixed step, the thesis' solver) or adaptive")->check(CLI::IsMember({"rk4", "adaptive"}));
   cmd->add_option("--stepper", a->stepper, "For --method adaptive: dopri5 or cash_karp")->check(CLI::IsMember({"dopri5", "cash_karp"}));
-  cmd->add_option("--substeps", a->substeps, "RK4 steps per sample interval (default 1)")->check(CLI::PositiveNumber);
+  cmd->add_option("--substeps", a->substeps, "RK4 steps per sample interval (default 1)")->check(whole_number_check(1));
   cmd->add_option("--tolerance", a->tolerance, "Absolute and relative tolerance of the adaptive method (default 1e-9)")->check(CLI::PositiveNumber);
   cmd->add_option("-o,--out", a->out, "Write the simulated outputs to this CSV file (default: stdout)");
   cmd->callback([a, &exit_status] { exit_status = run_simulate(*a); });

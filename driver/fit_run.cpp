@@ -148,6 +148,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
       RefineOptions ro;
       ro.evaluation = o.evaluation;
       ro.max_samples = a.refine_samples;
+      ro.segments = a.refine_segments;
       ro.from = o.from;
       ro.to = o.to;
       std::vector<const SampledRecord*> fitted;

@@ -42,6 +42,7 @@ struct FitSettings {
   std::vector<RecordInput> validate;          // records only compared with, not fitted
   std::size_t validate_samples = 0;           // compared at most per record (0 = all)
   std::size_t refine_samples = 100000;        // fitted by the refinement at most per record (0 = all)
+  int refine_segments = 0;                     // shooting segments per record (RefineOptions::segments; 0 = chosen)
   InitialState initial_state = InitialState::estimate;
   bool refine = false;
   std::string estimator;                      // "", least_squares or iv: over the model's `set estimator`

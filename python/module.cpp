@@ -308,7 +308,7 @@ std::vector<std::string> parameters(const ModelHandle& m) {
 using FitHandle = std::shared_ptr<FitSession>;  // never changed after the fit
 
 FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& kwargs) {
-  const Keywords k("fit", kwargs, with_record_keywords({"integrate", "form", "no_validate", "validate", "validate_samples", "refine_samples", "initial_state",
+  const Keywords k("fit", kwargs, with_record_keywords({"integrate", "form", "no_validate", "validate", "validate_samples", "refine_samples", "refine_segments", "initial_state",
                                                          "refine", "estimator", "local", "stride", "forget"}));
   driver::FitSettings s;
   s.records = record_settings(k);
@@ -320,6 +320,7 @@ FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& 
   if (auto* v = k.get("validate")) s.validate = record_inputs(*v);
   k.integer("validate_samples", s.validate_samples, 0);
   k.integer("refine_samples", s.refine_samples, 0);
+  k.integer("refine_segments", s.refine_segments, 0);
   k.text("initial_state", initial_state, {"estimate", "record"});
   if (initial_state == "record") s.initial_state = InitialState::record;
   k.flag("refine", s.refine);

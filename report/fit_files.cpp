@@ -346,7 +346,8 @@ nlohmann::ordered_json refinement_json(const RefineSummary& r) {
     for (const auto& [name, value] : rec.initial_state) state[name] = value;
     for (const auto& [name, value] : rec.rms_before) before[name] = value;
     for (const auto& [name, value] : rec.rms_after) after[name] = value;
-    records.push_back({{"path", rec.path}, {"first_sample", rec.first_sample}, {"samples", rec.samples}, {"initial_state", std::move(state)},
+    records.push_back({{"path", rec.path}, {"first_sample", rec.first_sample}, {"samples", rec.samples}, {"segments", rec.segments},
+                       {"initial_state", std::move(state)},
                        {"rms_error_before", std::move(before)}, {"rms_error_after", std::move(after)}});
   }
   return {{"status", to_string(r.status)}, {"message", r.message},      {"iterations", r.iterations},

@@ -46,6 +46,12 @@ struct RefineOptions {
   std::size_t max_samples = 0;   // per record, from the validation's start (0 = all)
   std::optional<double> from, to;  // the fit window (FitOptions): only its samples are compared
   EvaluationOptions evaluation;  // the fit's, for the moving-arc initial state
+  // Multiple shooting: each record's run cut into this many segments, each with its own initial
+  // state, joined by weighted continuity of the whole state (Bock's method as a penalty). 1: single
+  // shooting. 0: chosen from the data: single, unless the equation-error estimate's equations,
+  // solved from a record's start, diverge before its end; then segments of half the span they
+  // lasted (at least 20 samples), so that each can be solved and the refinement can start.
+  int segments = 0;
 };
 
 struct RefinedParameter {
@@ -59,6 +65,7 @@ struct RefinedParameter {
 struct RefinedRecord {
   std::string path;
   std::size_t samples = 0, first_sample = 0;  // compared, and the record's sample the run starts at
+  std::size_t segments = 1;                    // shooting segments (multiple shooting when above 1)
   std::vector<std::pair<std::string, double>> initial_state;  // ("y'", value), refined
   std::map<std::string, std::vector<double>> initial;         // the same, as SimulateOptions::initial
   std::vector<std::pair<std::string, double>> rms_before, rms_after;  // per output, unweighted
@@ -77,6 +84,8 @@ struct RefineSummary {
   std::vector<RefinedRecord> records;
   std::vector<std::pair<std::string, double>> output_noise;  // s_j: the weights' scale per output
   std::vector<int> substeps;                                  // RK4 steps per sample interval, per record
+  std::string shooting_reason;   // why segments were chosen (automatic multiple shooting), "" otherwise
+  double largest_defect = 0;     // multiple shooting: the largest state jump left at a join, in noise units
   // The whiteness test of each output's error (runtime/solve/residual_correlation.hpp, over the
   // records): the intervals assume it white; `whiteness` has each output's one-line verdict.
   bool output_error_white = true;

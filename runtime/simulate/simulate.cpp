@@ -512,7 +512,9 @@ bool SimulateOptions::is_valid(std::string* why) const {
   return true;
 }
 
-SimulateOptions SimulateOptions::first_samples(std::size_t n) const {
+SimulateOptions SimulateOptions::first_samples(std::size_t n) const { return samples(0, n); }
+
+SimulateOptions SimulateOptions::samples(std::size_t first, std::size_t last) const {
   SimulateOptions out;
   out.method = method;
   out.substeps = substeps;
@@ -523,10 +525,13 @@ SimulateOptions SimulateOptions::first_samples(std::size_t n) const {
   out.divergence_bound = divergence_bound;
   out.parameters = parameters;
   out.initial = initial;
-  const std::size_t kept = std::min(n, time.size());
-  out.time.assign(time.begin(), time.begin() + static_cast<std::ptrdiff_t>(kept));
-  for (const auto& [name, values] : inputs)
-    out.inputs[name].assign(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(kept, values.size())));
+  const std::size_t end = std::min(last, time.size()), begin = std::min(first, end);
+  const auto cut = [&](const std::vector<double>& values) {
+    const std::size_t b = std::min(begin, values.size()), e = std::min(end, values.size());
+    return std::vector<double>(values.begin() + static_cast<std::ptrdiff_t>(b), values.begin() + static_cast<std::ptrdiff_t>(e));
+  };
+  out.time = cut(time);
+  for (const auto& [name, values] : inputs) out.inputs[name] = cut(values);
   out.t0_for_tau = t0_for_tau;
   out.initial_value = initial_value;
   out.sensitivities = sensitivities;
@@ -579,7 +584,9 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
     summary.sensitivity.resize(form.outputs.size());
     for (auto& column : summary.sensitivity) column.assign(n * columns, kNaN);
   }
+  summary.final_vector.clear();
   auto record = [&](std::size_t row, const State& x) {
+    if (row + 1 == n) summary.final_vector.assign(x.begin(), x.end());
     for (std::size_t j = 0; j < form.outputs.size(); ++j) {
       summary.outputs[j][row] = x[system.state_offset_[j]];
       for (std::size_t q = 0; q < columns; ++q) summary.sensitivity[j][row * columns + q] = x[n_state + q * n_state + system.state_offset_[j]];

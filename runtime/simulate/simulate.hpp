@@ -73,6 +73,9 @@ struct SimulateOptions {
   // long record: copying 10^7 samples to keep 1000 costs more than the segment's run). Every other
   // setting as it is: a field added above must be added to this copy too.
   SimulateOptions first_samples(std::size_t n) const;
+  // The same for grid samples [first, last): a segment of a record (multiple shooting). The inputs'
+  // interpolation then sees the segment's samples only.
+  SimulateOptions samples(std::size_t first, std::size_t last) const;
 };
 
 struct SimulationSummary {
@@ -91,6 +94,10 @@ struct SimulationSummary {
   // y, y', ..., in the order of the explicit form's outputs).
   std::vector<std::vector<double>> sensitivity;
   std::size_t sensitivity_columns = 0;
+  // At the last grid time of a completed run: the state (explicit form's order, state_size() values)
+  // and, with sensitivities, d state / d q column by column (q as in `sensitivity`), state_size()
+  // values per column. Multiple shooting joins segments by it. Empty when the run stopped early.
+  std::vector<double> final_vector;
   bool completed() const { return status == Status::completed; }
   std::string brief_report() const;
 };

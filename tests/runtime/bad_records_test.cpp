@@ -23,7 +23,7 @@
 namespace sidc {
 namespace {
 
-const std::string kBad = std::string(SIDC_SOURCE_DIR) + "/tests/data/bad/";
+const std::string kBad = std::string(SIDC_SOURCE_DIR "/tests/data/bad/");
 
 struct BadRecord {
   const char* file;

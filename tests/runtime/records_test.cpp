@@ -16,7 +16,7 @@
 namespace sidc {
 namespace {
 
-const std::string kData = std::string(SIDC_SOURCE_DIR) + "/tests/runtime/data/";
+const std::string kData = std::string(SIDC_SOURCE_DIR "/tests/runtime/data/");
 
 Record parsed(std::string_view text, const CsvOptions& options = {}) {
   auto result = parse_csv(text, "mem.csv", options);

@@ -46,8 +46,11 @@ SampledRecord noisy_record(const ir::Model& m, const ExplicitForm& f, const std:
   return record;
 }
 
-RefineSummary refined(const ir::Model& m, const ExplicitForm& f, const std::vector<double>& start, const std::vector<const SampledRecord*>& records) {
-  auto r = refine(m, f, start, records, RefineOptions{});
+RefineSummary refined(const ir::Model& m, const ExplicitForm& f, const std::vector<double>& start, const std::vector<const SampledRecord*>& records,
+                      int segments = 0) {
+  RefineOptions options;
+  options.segments = segments;
+  auto r = refine(m, f, start, records, options);
   EXPECT_TRUE(std::holds_alternative<RefineSummary>(r)) << render(std::get<Diagnostic>(r));
   return std::get<RefineSummary>(r);
 }
@@ -135,12 +138,49 @@ TEST(Refine, AStartWhoseSolutionDivergesIsKeptAndSaidSo) {
   const ExplicitForm f = form_of(m);
   const SampledRecord record = noisy_record(m, f, {0.2, 1}, {{"y", {1, 0}}}, 200, 0.05, 0.01, 5);
   const std::vector<double> unstable = {-0.5, 1};  // negative damping: |y| grows past the divergence bound
-  const RefineSummary r = refined(m, f, unstable, {&record});
+  const RefineSummary r = refined(m, f, unstable, {&record}, 1);  // single shooting asked for
   EXPECT_EQ(r.status, RefineSummary::Status::failed);
   EXPECT_FALSE(r.improved());
   EXPECT_EQ(r.values, unstable);
   EXPECT_NE(r.message.find("diverged"), std::string::npos) << r.message;
   EXPECT_NE(r.report().find("not refined"), std::string::npos);
+}
+
+// The same start by default: its solution diverges at about t = 37 of 200, so the run is cut into
+// segments of half that span, each solved from its own initial state, joined by continuity; the
+// refinement then starts, and reaches the truth.
+TEST(Refine, MultipleShootingRefinesFromAStartWhoseSolutionDiverges) {
+  const ir::Model m = normalized("output y\nparam c, k\ny'' + c*y' + k*y = 0\n");
+  const ExplicitForm f = form_of(m);
+  const std::vector<double> truth = {0.2, 1};
+  const SampledRecord record = noisy_record(m, f, truth, {{"y", {1, 0}}}, 200, 0.05, 0.01, 5);
+  const RefineSummary r = refined(m, f, {-0.5, 1}, {&record});
+  ASSERT_TRUE(r.improved()) << r.message;
+  ASSERT_EQ(r.records.size(), 1u);
+  EXPECT_GT(r.records[0].segments, 1u);
+  EXPECT_NE(r.shooting_reason.find("stop at t ="), std::string::npos) << r.shooting_reason;
+  EXPECT_LT(largest_relative_error(r.values, truth), 0.02) << r.report();
+  EXPECT_LT(r.largest_defect, 0.1) << "the joined segments are expected continuous to a tenth of the noise";
+  EXPECT_NE(r.report().find("multiple shooting"), std::string::npos);
+  for (std::size_t q = 0; q < truth.size(); ++q) EXPECT_NEAR(r.values[q], truth[q], 4 * r.parameters[q].standard_error) << r.report();
+}
+
+// On a record single shooting handles, segments asked for reach the same minimum: the joins leave
+// the solution continuous, so the segments are one run again.
+TEST(Refine, SegmentsAskedForReachTheSingleShootingMinimum) {
+  const ir::Model m = normalized(kVanDerPol);
+  const ExplicitForm f = form_of(m);
+  const std::vector<double> truth = {-1, 1, 1};
+  const SampledRecord record = noisy_record(m, f, truth, {{"y", {2, 0}}}, 40, 0.02, 0.01, 7);
+  const std::vector<double> biased = {-0.97, 1.03, 0.99};
+  const RefineSummary single = refined(m, f, biased, {&record}, 1), four = refined(m, f, biased, {&record}, 4);
+  ASSERT_TRUE(single.improved() && four.improved()) << single.message << " / " << four.message;
+  EXPECT_EQ(four.records[0].segments, 4u);
+  for (std::size_t q = 0; q < truth.size(); ++q) {
+    EXPECT_NEAR(four.values[q], single.values[q], 0.1 * single.parameters[q].standard_error) << four.report();
+    EXPECT_NEAR(four.parameters[q].standard_error, single.parameters[q].standard_error, 0.1 * single.parameters[q].standard_error);
+  }
+  EXPECT_LT(four.largest_defect, 0.1);
 }
 
 }  // namespace

@@ -15,7 +15,7 @@
 namespace sidc {
 namespace {
 
-const std::string kCoefficientData = std::string(SIDC_SOURCE_DIR) + "/tests/runtime/data/";
+const std::string kCoefficientData = std::string(SIDC_SOURCE_DIR "/tests/runtime/data/");
 
 std::vector<double> weights_of(int window, int polyorder, int derivative, int position = -1, double delta = 1.0) {
   auto result = savitzky_golay_weights({window, polyorder, derivative, position, delta});

@@ -42,14 +42,14 @@ struct Rows {
 };
 
 Rows appendix() {
-  auto r = read_csv(std::string(SIDC_SOURCE_DIR) + "/examples/thesis-4-1/appendix_a.csv");
+  auto r = read_csv(std::string(SIDC_SOURCE_DIR "/examples/thesis-4-1/appendix_a.csv"));
   EXPECT_TRUE(std::holds_alternative<Record>(r));
   const Record& record = std::get<Record>(r);
   return {record.column("t")->to_vector(), record.column("y")->to_vector()};
 }
 
 SimulationSummary regenerate(int substeps, SimulateOptions::Method method = SimulateOptions::Method::rk4) {
-  const std::string path = std::string(SIDC_SOURCE_DIR) + "/examples/thesis-4-1/system_4_1_1.sid";
+  const std::string path = std::string(SIDC_SOURCE_DIR "/examples/thesis-4-1/system_4_1_1.sid");
   CompileResult c = compile(std::make_shared<const SourceFile>(path, read(path)), {});
   EXPECT_TRUE(c.ok()) << c.diagnostics.render_all();
   auto form = explicit_form(*c.normalized);

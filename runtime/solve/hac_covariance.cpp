@@ -1,4 +1,4 @@
-// The Newey-West sandwich with VAR(1) prewhitening and Andrews' bandwidth (see hac_covariance.hpp).
+// The Newey-West sandwich with AR(1) prewhitening and Andrews' bandwidth (see hac_covariance.hpp).
 #include "runtime/solve/hac_covariance.hpp"
 
 #include <fmt/format.h>

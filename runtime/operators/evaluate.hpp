@@ -93,6 +93,8 @@ class Evaluator {
 
   const FitWindow& window() const { return window_; }
   const SampledRecord& record() const { return record_; }
+  const ir::Model& model() const { return model_; }
+  const EvaluationOptions& options() const { return options_; }
 
   // The model has held or linear inputs: every integral is taken interval by interval, within the
   // segments between the inputs' changes of piece (runtime/operators/piecewise_inputs.hpp).

@@ -11,26 +11,24 @@ namespace sidc {
 
 namespace {
 
-using Eigen::Index;
-using Eigen::MatrixXd;
 
-struct Segment {
-  Index first = 0, rows = 0;
+struct ScoreSegment {
+  Eigen::Index first = 0, rows = 0;
 };
 
 // sum over segments of sum_t x_t y_{t-lag}^T (rows of x and y are aligned with the segments).
-MatrixXd lagged_products(const MatrixXd& x, const MatrixXd& y, const std::vector<Segment>& segments, Index lag) {
-  MatrixXd out = MatrixXd::Zero(x.cols(), y.cols());
+Eigen::MatrixXd lagged_products(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, const std::vector<ScoreSegment>& segments, Eigen::Index lag) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(x.cols(), y.cols());
   for (const auto& s : segments)
     if (s.rows > lag) out.noalias() += x.middleRows(s.first + lag, s.rows - lag).transpose() * y.middleRows(s.first, s.rows - lag);
   return out;
 }
 
 // Bartlett-weighted long-run covariance of the rows of u: sum over |l| < S of (1 - |l|/S) Gamma_l.
-MatrixXd bartlett_sum(const MatrixXd& u, const std::vector<Segment>& segments, double S) {
-  MatrixXd omega = lagged_products(u, u, segments, 0);
-  for (Index l = 1; static_cast<double>(l) < S; ++l) {
-    const MatrixXd gamma = lagged_products(u, u, segments, l);
+Eigen::MatrixXd bartlett_sum(const Eigen::MatrixXd& u, const std::vector<ScoreSegment>& segments, double S) {
+  Eigen::MatrixXd omega = lagged_products(u, u, segments, 0);
+  for (Eigen::Index l = 1; static_cast<double>(l) < S; ++l) {
+    const Eigen::MatrixXd gamma = lagged_products(u, u, segments, l);
     omega += (1.0 - static_cast<double>(l) / S) * (gamma + gamma.transpose());
   }
   return omega;
@@ -38,12 +36,12 @@ MatrixXd bartlett_sum(const MatrixXd& u, const std::vector<Segment>& segments, d
 
 // Andrews (1991), eq. 6.4 with AR(1) models of each column and equal weights: the plug-in
 // bandwidth of the Bartlett kernel, S = 1.1447 (alpha(1) T)^(1/3).
-double andrews_bandwidth(const MatrixXd& u, const std::vector<Segment>& segments, double T) {
+double andrews_bandwidth(const Eigen::MatrixXd& u, const std::vector<ScoreSegment>& segments, double T) {
   double numerator = 0, denominator = 0;
-  for (Index j = 0; j < u.cols(); ++j) {
+  for (Eigen::Index j = 0; j < u.cols(); ++j) {
     double xy = 0, xx = 0;
     for (const auto& s : segments)
-      for (Index t = s.first + 1; t < s.first + s.rows; ++t) {
+      for (Eigen::Index t = s.first + 1; t < s.first + s.rows; ++t) {
         xy += u(t, j) * u(t - 1, j);
         xx += u(t - 1, j) * u(t - 1, j);
       }
@@ -51,7 +49,7 @@ double andrews_bandwidth(const MatrixXd& u, const std::vector<Segment>& segments
     const double rho = std::clamp(xy / xx, -0.97, 0.97);
     double e2 = 0, count = 0;
     for (const auto& s : segments)
-      for (Index t = s.first + 1; t < s.first + s.rows; ++t) {
+      for (Eigen::Index t = s.first + 1; t < s.first + s.rows; ++t) {
         const double e = u(t, j) - rho * u(t - 1, j);
         e2 += e * e;
         ++count;
@@ -64,11 +62,11 @@ double andrews_bandwidth(const MatrixXd& u, const std::vector<Segment>& segments
   return std::max(1.0, 1.1447 * std::cbrt(numerator / denominator * T));
 }
 
-std::vector<Segment> segments_of(const std::vector<std::size_t>& segment_starts, Index n) {
-  std::vector<Segment> segments;
+std::vector<ScoreSegment> segments_of(const std::vector<std::size_t>& segment_starts, Eigen::Index n) {
+  std::vector<ScoreSegment> segments;
   for (std::size_t k = 0; k < segment_starts.size(); ++k) {
-    const auto first = static_cast<Index>(segment_starts[k]);
-    const Index last = k + 1 < segment_starts.size() ? static_cast<Index>(segment_starts[k + 1]) : n;
+    const auto first = static_cast<Eigen::Index>(segment_starts[k]);
+    const Eigen::Index last = k + 1 < segment_starts.size() ? static_cast<Eigen::Index>(segment_starts[k + 1]) : n;
     if (last > first) segments.push_back({first, last - first});
   }
   return segments;
@@ -78,13 +76,13 @@ std::vector<Segment> segments_of(const std::vector<std::size_t>& segment_starts,
 
 // The lag-1 autocorrelation of e, each segment's mean removed, pooled over segments.
 double lag1_autocorrelation(const std::vector<double>& e, const std::vector<std::size_t>& segment_starts) {
-  const std::vector<Segment> segments = segments_of(segment_starts, static_cast<Index>(e.size()));
+  const std::vector<ScoreSegment> segments = segments_of(segment_starts, static_cast<Eigen::Index>(e.size()));
   double c0 = 0, c1 = 0;
   for (const auto& s : segments) {
     double mean = 0;
-    for (Index t = s.first; t < s.first + s.rows; ++t) mean += e[static_cast<std::size_t>(t)];
+    for (Eigen::Index t = s.first; t < s.first + s.rows; ++t) mean += e[static_cast<std::size_t>(t)];
     mean /= static_cast<double>(s.rows);
-    for (Index t = s.first; t < s.first + s.rows; ++t) {
+    for (Eigen::Index t = s.first; t < s.first + s.rows; ++t) {
       const double x = e[static_cast<std::size_t>(t)] - mean;
       c0 += x * x;
       if (t > s.first) c1 += x * (e[static_cast<std::size_t>(t - 1)] - mean);
@@ -93,10 +91,10 @@ double lag1_autocorrelation(const std::vector<double>& e, const std::vector<std:
   return c0 > 0 ? c1 / c0 : 0.0;
 }
 
-LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vector<std::size_t>& segment_starts, double max_work) {
+LongRunCovariance long_run_covariance(const Eigen::MatrixXd& raw_scores, const std::vector<std::size_t>& segment_starts, double max_work) {
   LongRunCovariance out;
-  const Index n = raw_scores.rows(), p = raw_scores.cols();
-  const std::vector<Segment> segments = segments_of(segment_starts, n);
+  const Eigen::Index n = raw_scores.rows(), p = raw_scores.cols();
+  const std::vector<ScoreSegment> segments = segments_of(segment_starts, n);
   if (segments.empty() || p == 0) {
     out.note = "no rows";
     return out;
@@ -110,9 +108,9 @@ LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vec
   }
   // Each column scaled to unit mean square (mapped back at the end).
   Eigen::VectorXd scale = (raw_scores.colwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt().transpose();
-  for (Index j = 0; j < p; ++j)
+  for (Eigen::Index j = 0; j < p; ++j)
     if (!(scale(j) > 0) || !std::isfinite(scale(j))) scale(j) = 1;
-  const MatrixXd scores = raw_scores * scale.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd scores = raw_scores * scale.cwiseInverse().asDiagonal();
   if (!scores.allFinite()) {
     out.note = "a score is not finite";
     return out;
@@ -123,10 +121,10 @@ LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vec
   // recolour by noise (measured on the thesis' 36-row, 13-parameter fit: ratios 0.66 to 2.1 on
   // white residuals).
   Eigen::VectorXd rho = Eigen::VectorXd::Zero(p);
-  for (Index j = 0; j < p; ++j) {
+  for (Eigen::Index j = 0; j < p; ++j) {
     double xy = 0, xx = 0;
     for (const auto& s : segments)
-      for (Index t = s.first + 1; t < s.first + s.rows; ++t) {
+      for (Eigen::Index t = s.first + 1; t < s.first + s.rows; ++t) {
         xy += scores(t, j) * scores(t - 1, j);
         xx += scores(t - 1, j) * scores(t - 1, j);
       }
@@ -137,11 +135,11 @@ LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vec
     }
   }
   // Whitened rows: each segment loses its first row.
-  std::vector<Segment> whitened_segments;
-  MatrixXd u(n - static_cast<Index>(segments.size()), p);
-  Index row = 0;
+  std::vector<ScoreSegment> whitened_segments;
+  Eigen::MatrixXd u(n - static_cast<Eigen::Index>(segments.size()), p);
+  Eigen::Index row = 0;
   for (const auto& s : segments) {
-    const Index m = s.rows - 1;
+    const Eigen::Index m = s.rows - 1;
     if (m <= 0) continue;
     u.middleRows(row, m) = scores.middleRows(s.first + 1, m) - scores.middleRows(s.first, m) * rho.asDiagonal();
     whitened_segments.push_back({row, m});
@@ -154,7 +152,7 @@ LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vec
     out.note = fmt::format("not computed: {} rows, {} parameters and {:.0f} lags are beyond its work limit", n, p, out.bandwidth);
     return out;
   }
-  const MatrixXd omega_u = bartlett_sum(u, whitened_segments, out.bandwidth);
+  const Eigen::MatrixXd omega_u = bartlett_sum(u, whitened_segments, out.bandwidth);
   const Eigen::VectorXd recolour = (Eigen::VectorXd::Ones(p) - rho).cwiseInverse().cwiseProduct(scale);
   out.omega = recolour.asDiagonal() * omega_u * recolour.asDiagonal();
   out.computed = out.omega.allFinite();
@@ -162,24 +160,24 @@ LongRunCovariance long_run_covariance(const MatrixXd& raw_scores, const std::vec
   return out;
 }
 
-HacEstimate hac_covariance(const MatrixXd& A, const std::vector<double>& residuals, const Eigen::VectorXd* weights,
+HacEstimate hac_covariance(const Eigen::MatrixXd& A, const std::vector<double>& residuals, const Eigen::VectorXd* weights,
                            const std::vector<std::size_t>& segment_starts, const LeastSquaresSummary& summary, const HacOptions& options) {
   HacEstimate out;
   out.level = options.confidence_level;
-  const Index n = A.rows(), p = A.cols();
+  const Eigen::Index n = A.rows(), p = A.cols();
   if (!summary.is_solution_usable()) {
     out.note = "the fit is not usable";
     return out;
   }
-  if (static_cast<Index>(residuals.size()) != n || p == 0 || summary.parameters.size() != static_cast<std::size_t>(p) ||
+  if (static_cast<Eigen::Index>(residuals.size()) != n || p == 0 || summary.parameters.size() != static_cast<std::size_t>(p) ||
       summary.covariance.rows() != p || !summary.covariance.allFinite() || !(summary.residual_sd > 0)) {
     out.note = "the classical covariance has no finite value to start from";
     return out;
   }
   // The scores s_i = w_i^2 r_i a_i, and the weighted residuals w_i r_i.
-  MatrixXd scores(n, p);
+  Eigen::MatrixXd scores(n, p);
   std::vector<double> weighted(static_cast<std::size_t>(n));
-  for (Index i = 0; i < n; ++i) {
+  for (Eigen::Index i = 0; i < n; ++i) {
     const double w = weights ? (*weights)(i) : 1.0;
     weighted[static_cast<std::size_t>(i)] = w * residuals[static_cast<std::size_t>(i)];
     scores.row(i) = (w * w * residuals[static_cast<std::size_t>(i)]) * A.row(i);
@@ -196,14 +194,14 @@ HacEstimate hac_covariance(const MatrixXd& A, const std::vector<double>& residua
   const double dof = static_cast<double>(summary.n) - static_cast<double>(summary.rank);
   const double small_sample = dof > 0 ? static_cast<double>(n) / dof : 1.0;
   const double sigma2 = summary.residual_sd * summary.residual_sd;
-  const MatrixXd bread = summary.covariance / sigma2;  // (A^T W^2 A)^-1
+  const Eigen::MatrixXd bread = summary.covariance / sigma2;  // (A^T W^2 A)^-1
   out.covariance = small_sample * (bread * omega.omega * bread);
   if (!out.covariance.allFinite()) {
     out.note = "the sandwich is not finite";
     return out;
   }
   out.computed = true;
-  for (Index j = 0; j < p; ++j) {
+  for (Eigen::Index j = 0; j < p; ++j) {
     const ParameterEstimate& c = summary.parameters[static_cast<std::size_t>(j)];
     const double se = std::sqrt(std::max(0.0, out.covariance(j, j)));
     // The classical interval's Student t quantile, read back from it.

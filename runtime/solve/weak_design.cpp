@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <map>
+#include <mutex>
 #include <set>
 
 #include <fmt/format.h>
 
 #include "diagnostics/data_catalogue.hpp"
 #include "ir/traversal.hpp"
+#include "runtime/operators/block_evaluator.hpp"
 #include "runtime/operators/piecewise_inputs.hpp"
 #include "runtime/parallel_ranges.hpp"
 
@@ -78,6 +80,54 @@ std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::
 
 WeakValues::WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid) : evaluator_(evaluator), grid_(grid) {}
 
+std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out) {
+  const FitWindow& window = evaluator_.window();
+  const SampledRecord& record = evaluator_.record();
+  const std::size_t n = window.size(), m = grid_.half_width, count = std::min(grid_.centres.size(), out.size());
+  auto prepared = prepare_whole_window_values(record, evaluator_.model(), evaluator_.options(), window, {&g});
+  if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
+  const WholeWindowValues& whole = std::get<WholeWindowValues>(prepared);
+  // Window samples in blocks; row j belongs to the block its support's first sample c_j - m lies
+  // in, and g is evaluated on the block and the 2m samples after it. A value that is not finite is
+  // looked for on the block's own samples, and the first by term, then sample, is the one
+  // Evaluator::evaluate_in_window names.
+  constexpr std::size_t kBlock = std::size_t{1} << 15;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  std::mutex found;
+  std::optional<NonFiniteValue> first_bad;
+  std::optional<Diagnostic> structural;  // a problem that is not a value (the same on every block)
+  // Each row is its own dot product: the blocks split over the cores (at 10^7 samples, 8
+  // subdomains cover each sample: about 8 * 10^7 products per column, the weak fit's largest cost).
+  for_parallel_ranges(blocks, n * w.size(), [&](std::size_t b0, std::size_t b1) {
+    BlockEvaluator evaluator(record, evaluator_.options(), window, whole);
+    std::vector<double> values;
+    for (std::size_t b = b0; b < b1; ++b) {
+      const std::size_t start = b * kBlock, end = std::min(n, start + kBlock), last = std::min(n, end + 2 * m);
+      values.assign(last - start, 0.0);
+      evaluator.start_block(window.first + start, window.first + last);
+      std::optional<NonFiniteValue> bad;
+      auto status = evaluator.evaluate(g, values, &bad);
+      if (auto* d = std::get_if<Diagnostic>(&status)) {
+        const std::lock_guard<std::mutex> lock(found);
+        if (!structural) structural = std::move(*d);
+        return;
+      }
+      if (bad && bad->sample < window.first + end) {
+        const std::lock_guard<std::mutex> lock(found);
+        if (!first_bad || std::pair{bad->term, bad->sample} < std::pair{first_bad->term, first_bad->sample}) first_bad = bad;
+      }
+      // Rows whose support starts in [start, end): c_j - m >= start, c_j - m < end.
+      const auto from = std::lower_bound(grid_.centres.begin(), grid_.centres.begin() + static_cast<std::ptrdiff_t>(count), start + m);
+      const auto to = std::lower_bound(from, grid_.centres.begin() + static_cast<std::ptrdiff_t>(count), end + m);
+      for (auto it = from; it != to; ++it)
+        out[static_cast<std::size_t>(it - grid_.centres.begin())] += support_dot(w, values.data() + (*it - m - start));
+    }
+  });
+  if (structural) return structural;
+  if (first_bad) return non_finite_value(record, g, *first_bad, what);
+  return std::nullopt;
+}
+
 std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, const std::string& what, std::span<double> out) {
   std::map<int, std::vector<ir::Term>> parts;  // g_k by the order k of phi_j^(k)
   for (const auto& t : sum.terms) {
@@ -91,15 +141,7 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
     auto& w = weights_[static_cast<std::size_t>(k)];
     if (w.empty()) w = test_function_weights(grid_, k, evaluator_.record().step);
     if (!evaluator_.segmented()) {
-      if (auto problem = evaluator_.evaluate_in_window(ir::canonical(terms), what, values_)) return problem;
-      const std::vector<double>& g = values_;
-      const std::size_t count = std::min(grid_.centres.size(), out.size());
-      auto rows = [&](std::size_t from, std::size_t to) {
-        for (std::size_t j = from; j < to; ++j) out[j] += support_dot(w, g.data() + (grid_.centres[j] - m));
-      };
-      // Each row is its own dot product: the rows split over the cores (at 10^7 samples, 8
-      // subdomains cover each sample: about 8 * 10^7 products per column, the weak fit's largest cost).
-      for_parallel_ranges(count, count * w.size(), rows);
+      if (auto problem = add_rows(ir::canonical(terms), what, w, out)) return problem;
       continue;
     }
     // Held or linear inputs: int phi^(k) g interval by interval within the inputs' segments, g read
@@ -132,16 +174,20 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
                                                         Evaluator& evaluator, const DesignBuilder& design,
                                                         const std::vector<std::size_t>& equations, std::span<const double> expression) {
   WeakDesign out;
-  std::vector<std::vector<double>> values;
-  for (const auto& name : outputs_used(model, design)) {
-    auto v = evaluator.evaluate_in_window(signal_sum(name), "the output `" + name + "`");
-    if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
-    values.push_back(std::get<std::vector<double>>(std::move(v)));
+  std::variant<TestFunctionGrid, Diagnostic> chosen = Diagnostic{};
+  {
+    // The outputs on the window, only while the width is chosen (80 MB each at 10^7 samples).
+    std::vector<std::vector<double>> values;
+    for (const auto& name : outputs_used(model, design)) {
+      auto v = evaluator.evaluate_in_window(signal_sum(name), "the output `" + name + "`");
+      if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
+      values.push_back(std::get<std::vector<double>>(std::move(v)));
+    }
+    const std::vector<std::span<const double>> spans(values.begin(), values.end());
+    const std::size_t fewest_rows = std::max<std::size_t>(20, 4 * design.columns().size());
+    chosen = choose_test_functions(spans, evaluator.window().size(), records[r].step, highest_test_function_order(design), fewest_rows,
+                                   records[r].path);
   }
-  const std::vector<std::span<const double>> spans(values.begin(), values.end());
-  const std::size_t fewest_rows = std::max<std::size_t>(20, 4 * design.columns().size());
-  auto chosen = choose_test_functions(spans, evaluator.window().size(), records[r].step, highest_test_function_order(design),
-                                      fewest_rows, records[r].path);
   if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
   out.grids.push_back(std::get<TestFunctionGrid>(std::move(chosen)));
   const TestFunctionGrid& grid = out.grids.back();

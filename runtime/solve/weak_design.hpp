@@ -8,8 +8,8 @@
 // rows run record by record, equation by equation, subdomain centres increasing (the times given
 // are the centres); a weighted row (eq. 2-1.6) carries the phi-weighted mean of its samples' weights,
 // or 0 when one of them is 0 (a masked sample takes out every subdomain it lies in).
-// The weak design has few rows (about 4 n / m), so it is always solved dense; its evaluation holds
-// each g_k on the whole window (memory linear in n).
+// The weak design has few rows (about 4 n / m), so it is always solved dense; each g_k is evaluated
+// block by block (memory of a block, not of the record; held or linear inputs: on the whole window).
 #pragma once
 
 #include <optional>
@@ -38,10 +38,13 @@ class WeakValues final : public DesignValues {
                                      std::span<double> out) override;
 
  private:
+  // out[j] += integral(phi_j^(k) g) for every row, g evaluated block by block (block_evaluator.hpp:
+  // Evaluator's values bit for bit) on the blocks' threads: memory of a block, not of the window.
+  std::optional<Diagnostic> add_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out);
+
   Evaluator& evaluator_;
   const TestFunctionGrid& grid_;
   std::vector<std::vector<double>> weights_;  // per derivative order of phi, made when first asked for
-  std::vector<double> values_;                // g_k on the window, its memory kept from sum to sum
 };
 
 struct WeakDesign {

@@ -27,6 +27,7 @@
 #include "ir/print.hpp"
 #include "runtime/operators/test_functions.hpp"
 #include "runtime/solve/fit.hpp"
+#include "runtime/solve/weak_design.hpp"
 #include "support/fit_error.hpp"
 
 namespace sidc {
@@ -167,6 +168,110 @@ TEST(WeakFit, NoisyRecordStaysClose) {
   const double derivative = largest_relative_error("input x\noutput y\nparam m, c, k, k3\nset derivative = savgol(7, 3)\n" + equation, record, truth);
   EXPECT_LT(weak, 0.01);
   EXPECT_GT(derivative, 10 * weak) << "the derivative form is expected far worse on this record";
+}
+
+// The rows come from g evaluated block by block (32,768 samples and the supports after them), not
+// on the whole window: on a record of 100,000 samples (four blocks, supports straddling each
+// boundary) every row equals, bit for bit, the integral of g evaluated on the whole window by
+// Evaluator, summed in weak_design.cpp's order (four running sums, added pairwise).
+double reference_dot(const std::vector<double>& w, const double* x) {
+  const std::size_t n = w.size(), whole = n - n % 4;
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  for (std::size_t i = 0; i < whole; i += 4) {
+    s0 += w[i] * x[i];
+    s1 += w[i + 1] * x[i + 1];
+    s2 += w[i + 2] * x[i + 2];
+    s3 += w[i + 3] * x[i + 3];
+  }
+  for (std::size_t i = whole; i < n; ++i) s0 += w[i] * x[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
+TEST(WeakValues, BlocksGiveTheWholeWindowsRowsBitForBit) {
+  const auto duffing = [](double y, double v, double x) { return x - 0.25 * v - y - 0.5 * y * y * y; };
+  const SampledRecord record = simulate(duffing, forcing, 100000, 0.01, 0.01, 3);
+  CompileResult c = compile(std::make_shared<const SourceFile>(
+                                "blocks.sid", "input x\noutput y\nparam m, c, k, k3, s\nset derivative = savgol(9, 3)\n"
+                                              "set form = weak\nm*y'' + c*y' + k*y + k3*y^3 + s*sin(y)*y' = x\n"),
+                            {});
+  ASSERT_TRUE(c.ok()) << c.diagnostics.render_all();
+  const ir::Model& model = *c.integrated;
+  const FitWindow window{10, record.time.size() - 11};
+  Evaluator whole(record, model, EvaluationOptions{}, window), blocks(record, model, EvaluationOptions{}, window);
+  TestFunctionGrid grid;
+  grid.half_width = 150;
+  grid.degree = 10;
+  for (std::size_t centre = grid.half_width; centre + grid.half_width < window.size(); centre += 75) grid.centres.push_back(centre);
+  ASSERT_GT(grid.centres.back(), 3 * (std::size_t{1} << 15));  // rows in every block
+  WeakValues weak(blocks, grid);
+  std::size_t compared = 0;
+  for (const auto& equation : model.equations)
+    for (const auto& term : equation.terms) {
+      std::vector<double> rows(grid.centres.size());
+      ASSERT_FALSE(weak.evaluate(term.operation, 0, "the operation", rows).has_value());
+      // The reference: each phi^(k) part's g on the whole window, then the dot products.
+      std::vector<double> expected(grid.centres.size(), 0.0);
+      std::map<int, std::vector<ir::Term>> parts;
+      for (const auto& t : term.operation.terms) {
+        ir::Term rest = t;
+        int order = 0;
+        for (auto it = rest.factors.begin(); it != rest.factors.end(); ++it)
+          if (it->first.kind == ir::FactorKind::test_function) {
+            order = it->first.order;
+            rest.factors.erase(it);
+            break;
+          }
+        parts[order].push_back(ir::canonical(rest));
+      }
+      for (const auto& [k, terms] : parts) {
+        std::vector<double> g;
+        ASSERT_FALSE(whole.evaluate_in_window(ir::canonical(terms), "g", g).has_value());
+        const std::vector<double> w = test_function_weights(grid, k, record.step);
+        for (std::size_t j = 0; j < grid.centres.size(); ++j) expected[j] += reference_dot(w, g.data() + (grid.centres[j] - grid.half_width));
+      }
+      for (std::size_t j = 0; j < rows.size(); ++j) ASSERT_EQ(rows[j], expected[j]) << print(term.operation) << ", row " << j;
+      ++compared;
+    }
+  EXPECT_EQ(compared, 5u);
+}
+
+// A value that is not finite in the third block is named as Evaluator names it: the same term, the
+// same time.
+TEST(WeakValues, AValueThatIsNotFiniteIsNamedAsOnTheWholeWindow) {
+  const auto oscillator = [](double y, double v, double x) { return (x - 0.3 * v - 2.0 * y) / 1.0; };
+  SampledRecord record = simulate(oscillator, forcing, 100000, 0.01, 0.0, 0);
+  record.signals["x"].owned()[70000] = -3;  // log(x + 3) is -inf there (x stays above -2.3 elsewhere)
+  CompileResult c = compile(std::make_shared<const SourceFile>(
+                                "bad.sid", "input x\noutput y\nparam m, c, k\nset form = weak\nm*y'' + c*y' + k*log(x + 3)*y = x\n"),
+                            {});
+  ASSERT_TRUE(c.ok()) << c.diagnostics.render_all();
+  const ir::Model& model = *c.integrated;
+  const FitWindow window{0, record.time.size() - 1};
+  Evaluator whole(record, model, EvaluationOptions{}, window), blocks(record, model, EvaluationOptions{}, window);
+  TestFunctionGrid grid;
+  grid.half_width = 100;
+  grid.degree = 10;
+  for (std::size_t centre = grid.half_width; centre + grid.half_width < window.size(); centre += 50) grid.centres.push_back(centre);
+  WeakValues weak(blocks, grid);
+  for (const auto& term : model.equations[0].terms) {
+    std::vector<double> rows(grid.centres.size());
+    auto problem = weak.evaluate(term.operation, 0, "the operation", rows);
+    if (print(term.operation).find("log") == std::string::npos) {
+      EXPECT_FALSE(problem.has_value());
+      continue;
+    }
+    ASSERT_TRUE(problem.has_value());
+    ir::Sum g;
+    for (auto t : term.operation.terms) {
+      std::erase_if(t.factors, [](const auto& f) { return f.first.kind == ir::FactorKind::test_function; });
+      g.terms.push_back(ir::canonical(t));
+    }
+    std::vector<double> values;
+    auto expected = whole.evaluate_in_window(ir::canonical(g.terms), "the operation", values);
+    ASSERT_TRUE(expected.has_value());
+    EXPECT_EQ(problem->message, expected->message);
+    EXPECT_NE(problem->message.find("700"), std::string::npos) << problem->message;  // t = 700 (sample 70,000)
+  }
 }
 
 }  // namespace

@@ -308,13 +308,17 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
       }
     }
     length = std::max<std::size_t>(std::min(length, total), 2);
-    // Segments share their ends: `pieces` of step_samples intervals each (the last may be shorter).
-    const std::size_t pieces = options.segments > 1 ? std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(options.segments), (total - 1) / 2))
+    // Segments share their ends: `pieces` of them, the record's intervals shared out evenly.
+    // A segment asked for keeps at least kMinShootingSamples samples (shorter ones carry too little of
+    // the record to pin their own initial state).
+    const std::size_t pieces = options.segments > 1 ? std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(options.segments),
+                                                                                                     (total - 1) / kMinShootingSamples))
                                : length >= total  ? 1
                                                   : std::max<std::size_t>(1, (total - 1 + length - 2) / (length - 1));
-    const std::size_t step_samples = pieces > 1 ? (total - 1 + pieces - 1) / pieces : total;
+    // Segment k covers grid samples [bound(k), bound(k + 1)], the intervals shared out evenly.
+    const auto bound = [&](std::size_t k) { return k * (total - 1) / pieces; };
     if (pieces > 1 && options.substeps == 0)  // the steps from the first segment's run
-      chosen = substeps_for(normalized, form, RecordRun{run.options.samples(0, step_samples + 1), {}, run.start, false}, tolerance);
+      chosen = substeps_for(normalized, form, RecordRun{run.options.samples(0, bound(1) + 1), {}, run.start, false}, tolerance);
     if (options.substeps > 0) run.options.substeps = options.substeps;
     else if (chosen) run.options.substeps = *chosen;
     summary.substeps.push_back(run.options.substeps);
@@ -325,7 +329,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
     r.segments = pieces;
     summary.records.push_back(std::move(r));
     for (std::size_t k = 0; k < pieces; ++k) {
-      const std::size_t a = k * step_samples, b = std::min(total, (k + 1) * step_samples + 1);  // [a, b), sharing b - 1
+      const std::size_t a = bound(k), b = bound(k + 1) + 1;  // [a, b), sharing b - 1 with the next (bound(pieces) = total - 1)
       const bool last = k + 1 == pieces;
       RecordRun piece{run.options.samples(a, b), {}, run.start + a, false};
       for (const auto& column : run.recorded)

@@ -46,11 +46,12 @@ struct RefineOptions {
   std::size_t max_samples = 0;   // per record, from the validation's start (0 = all)
   std::optional<double> from, to;  // the fit window (FitOptions): only its samples are compared
   EvaluationOptions evaluation;  // the fit's, for the moving-arc initial state
-  // Multiple shooting: each record's run cut into this many segments, each with its own initial
-  // state, joined by weighted continuity of the whole state (Bock's method as a penalty). 1: single
-  // shooting. 0: chosen from the data: single, unless the equation-error estimate's equations,
-  // solved from a record's start, diverge before its end; then segments of half the span they
-  // lasted (at least 20 samples), so that each can be solved and the refinement can start.
+  // Multiple shooting: each record's run cut into this many segments (at most one per 20 samples),
+  // each with its own initial state, joined by weighted continuity of the whole state (Bock's method
+  // as a penalty). 1: single shooting. 0: chosen from the data: single, unless the
+  // equation-error estimate's equations, solved from a record's start, diverge before its end; then
+  // segments of half the span they lasted (at least 20 samples), so that each can be solved and the
+  // refinement can start.
   int segments = 0;
 };
 

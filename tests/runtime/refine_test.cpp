@@ -181,6 +181,14 @@ TEST(Refine, SegmentsAskedForReachTheSingleShootingMinimum) {
     EXPECT_NEAR(four.parameters[q].standard_error, single.parameters[q].standard_error, 0.1 * single.parameters[q].standard_error);
   }
   EXPECT_LT(four.largest_defect, 0.1);
+  // More segments than the record holds 20 samples for: one per 20 samples, every one non-empty
+  // (an uneven split once left the last one past the record's end).
+  for (int asked : {99, 100000}) {
+    const RefineSummary many = refined(m, f, biased, {&record}, asked);
+    ASSERT_TRUE(many.improved()) << many.message;
+    EXPECT_EQ(many.records[0].segments, std::min<std::size_t>(static_cast<std::size_t>(asked), (many.records[0].samples - 1) / 20));
+    EXPECT_LT(largest_relative_error(many.values, truth), 0.01) << many.report();
+  }
 }
 
 }  // namespace

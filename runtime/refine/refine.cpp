@@ -88,17 +88,10 @@ class RecordCost final : public ceres::CostFunction {
     return true;
   }
 
-  const SimulationSummary* last_run() const { return cached_ok_ ? &cached_ : nullptr; }
   // Why the last run gave no usable residuals.
   std::string last_failure() const {
     if (!cached_.completed()) return cached_.message;
     return "its solution is not finite";
-  }
-
-  double rms(std::size_t output, const SimulationSummary& s) const {
-    double total = 0;
-    for (std::size_t i = 0; i < rows(); ++i) total += std::pow(run_.recorded[output][i] - s.outputs[output][i], 2);
-    return std::sqrt(total / static_cast<double>(rows()));
   }
 
  private:
@@ -287,34 +280,29 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
       tolerance.push_back(noisy ? 0.01 * noise.sigma : 1e-6 * spread);
       if (segments.empty()) summary.output_noise.emplace_back(form.outputs[j].name, s);
     }
-    // Segment length: the whole record, RefineOptions::segments pieces, or (automatic) half the span
-    // the equation-error estimate's equations stay solvable over from the record's start when they
-    // do not last the whole record (an unstable or badly started run: multiple shooting).
-    std::size_t length = total;
-    if (options.segments > 1) length = (total + static_cast<std::size_t>(options.segments) - 1) / static_cast<std::size_t>(options.segments);
-    std::optional<int> chosen;
-    if (options.substeps == 0 && options.segments != 0 && length == total) chosen = substeps_for(normalized, form, run, tolerance);
-    if (options.substeps == 0 && options.segments == 0) {
+    // Segments: RefineOptions::segments of them (at least kMinShootingSamples samples each: shorter
+    // ones carry too little of the record to pin their own initial state), one (single shooting),
+    // or (automatic) segments of half the span the equation-error estimate's equations stay solvable
+    // over from the record's start when they do not last the whole record (an unstable or badly
+    // started run: multiple shooting). They share their ends, the record's intervals shared out evenly.
+    std::optional<int> chosen;  // RK4 steps per sample interval, from the data (options.substeps 0)
+    std::size_t pieces = 1;
+    if (options.segments > 1) {
+      pieces = std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(options.segments), (total - 1) / kMinShootingSamples));
+    } else if (options.substeps == 0) {
       chosen = substeps_for(normalized, form, run, tolerance);  // nullopt: the run did not last
-      if (!chosen && total >= 2 * kMinShootingSamples) {
+      if (!chosen && options.segments == 0 && total >= 2 * kMinShootingSamples) {
         auto trial = simulate(normalized, form, run.options);
         if (auto* t = std::get_if<SimulationSummary>(&trial); t && !t->completed() && t->stopped_at) {
           const auto lasted = static_cast<std::size_t>(
               std::lower_bound(run.options.time.begin(), run.options.time.end(), *t->stopped_at) - run.options.time.begin());
-          length = std::max(kMinShootingSamples, lasted / 2);
+          const std::size_t length = std::min(std::max(kMinShootingSamples, lasted / 2), total);
+          pieces = length >= total ? 1 : (total - 1 + length - 2) / (length - 1);
           summary.shooting_reason = fmt::format("the equation-error estimate's equations, solved from the start of {}, stop at t = {:.6g} ({})",
                                                 record->path, *t->stopped_at, t->message);
         }
       }
     }
-    length = std::max<std::size_t>(std::min(length, total), 2);
-    // Segments share their ends: `pieces` of them, the record's intervals shared out evenly.
-    // A segment asked for keeps at least kMinShootingSamples samples (shorter ones carry too little of
-    // the record to pin their own initial state).
-    const std::size_t pieces = options.segments > 1 ? std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(options.segments),
-                                                                                                     (total - 1) / kMinShootingSamples))
-                               : length >= total  ? 1
-                                                  : std::max<std::size_t>(1, (total - 1 + length - 2) / (length - 1));
     // Segment k covers grid samples [bound(k), bound(k + 1)], the intervals shared out evenly.
     const auto bound = [&](std::size_t k) { return k * (total - 1) / pieces; };
     if (pieces > 1 && options.substeps == 0)  // the steps from the first segment's run

@@ -377,6 +377,13 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
 
 }  // namespace
 
+std::vector<std::size_t> neighbour_runs(const GroupFit& g) {
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i < g.row_record.size(); ++i)
+    if (i == 0 || g.row_record[i] != g.row_record[i - 1] || g.row_equation[i] != g.row_equation[i - 1]) starts.push_back(i);
+  return starts;
+}
+
 int stream_thread_count(const FitOptions& options) {
   if (options.stream_threads > 0) return options.stream_threads;
   return core_count();
@@ -495,13 +502,9 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
     g.summary = solve_least_squares(A, b, g.columns, g.weighted ? &weights : nullptr, options.least_squares);
     design.label(g.summary);
     if (!is_static(model)) {  // a static model's rows are observations, not neighbours in time
-      // Neighbouring rows: one record's window for one equation (window_rows' order).
-      std::vector<std::size_t> segments;
-      for (std::size_t i = 0; i < g.row_time.size(); ++i)
-        if (i == 0 || g.row_record[i] != g.row_record[i - 1] || g.row_equation[i] != g.row_equation[i - 1]) segments.push_back(i);
       HacOptions hac;
       hac.confidence_level = options.least_squares.confidence_level;
-      g.hac = hac_covariance(A, g.summary.residuals, g.weighted ? &weights : nullptr, segments, g.summary, hac);
+      g.hac = hac_covariance(A, g.summary.residuals, g.weighted ? &weights : nullptr, neighbour_runs(g), g.summary, hac);
     }
     summary.groups.push_back(std::move(g));
   }

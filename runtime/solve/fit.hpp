@@ -116,6 +116,10 @@ struct FitSummary {
 std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vector<SampledRecord>& records,
                                          const FitOptions& options);
 
+// The first rows of a group's runs of neighbouring rows (one record's rows of one equation, from
+// row_record and row_equation): where a lag of the Newey-West intervals must stop.
+std::vector<std::size_t> neighbour_runs(const GroupFit& g);
+
 // A warning per group whose statistics are not finite or not representable in a double
 // (least_squares.hpp: unrepresentable_statistics), at its first equation.
 std::vector<Diagnostic> statistics_warnings(const ir::Model& model, const FitSummary& summary);

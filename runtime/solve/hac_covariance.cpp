@@ -209,7 +209,6 @@ HacEstimate hac_covariance(const Eigen::MatrixXd& A, const std::vector<double>& 
     out.standard_errors.push_back(se);
     out.ci_low.push_back(c.value - t * se);
     out.ci_high.push_back(c.value + t * se);
-    if (c.standard_error > 0) out.largest_ratio = std::max(out.largest_ratio, se / c.standard_error);
   }
   return out;
 }

@@ -56,7 +56,6 @@ struct HacEstimate {
   double bandwidth = 0;                 // S: lags |l| < S weighted 1 - |l|/S
   double lag1_autocorrelation = 0;      // of the residuals, segments mean-removed and pooled
   double band = 0;                      // 2.576 / sqrt(n): the 99% band of a white residual
-  double largest_ratio = 0;             // max over columns of HAC / classical standard error
   bool prewhitening_clamped = false;    // an AR(1) coefficient was brought down to 0.97
 };
 

@@ -496,10 +496,8 @@ InstrumentalVariablesSummary instrumental_variables(const ir::Model& model, cons
       }
       // Neighbouring rows (one record's window of one equation) for the Newey-West intervals; not
       // for the weak form, whose rows are overlapping subdomains (docs/accuracy.md).
-      std::vector<std::size_t> segments;
       const GroupFit& fg = fitted.groups[g];
-      for (std::size_t i = 0; i < fg.row_record.size(); ++i)
-        if (i == 0 || fg.row_record[i] != fg.row_record[i - 1] || fg.row_equation[i] != fg.row_equation[i - 1]) segments.push_back(i);
+      const std::vector<std::size_t> segments = neighbour_runs(fg);
       const bool with_hac = !groups[g].weak && fg.row_record.size() == static_cast<std::size_t>(groups[g].A.rows());
       IvSolution solution = solve_iv(groups[g].A, groups[g].b, Z, groups[g].weights, fitted.groups[g].columns, with_hac ? &segments : nullptr);
       if (!solution.problem.empty()) {

@@ -16,23 +16,6 @@
 namespace sidc {
 namespace {
 
-// sum_i w[i] * x[i] over a test function's support (thousands of samples) in four running sums,
-// added pairwise at the end: one sum would wait on each addition in turn (a latency of four
-// cycles per product); four keep the multiply-add units busy. The order is fixed, so the result is
-// the same on every run and thread.
-double support_dot(const std::vector<double>& w, const double* x) {
-  const std::size_t n = w.size(), whole = n - n % 4;
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  for (std::size_t i = 0; i < whole; i += 4) {
-    s0 += w[i] * x[i];
-    s1 += w[i + 1] * x[i + 1];
-    s2 += w[i + 2] * x[i + 2];
-    s3 += w[i + 3] * x[i + 3];
-  }
-  for (std::size_t i = whole; i < n; ++i) s0 += w[i] * x[i];
-  return (s0 + s1) + (s2 + s3);
-}
-
 // The order of a term's test function and the term without it (weak_pass puts exactly one,
 // to the power 1, on every term; the compiled-model reader checks files for the same).
 std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
@@ -70,6 +53,23 @@ std::set<std::string> outputs_used(const ir::Model& model, const DesignBuilder& 
 ir::Sum signal_sum(const std::string& name) { return ir::factor(ir::Factor{ir::FactorKind::signal, name, 0, {}, {}, {}, {}}); }
 
 }  // namespace
+
+// sum_i w[i] * x[i] over a test function's support (thousands of samples) in four running sums,
+// added pairwise at the end: one sum would wait on each addition in turn (a latency of four
+// cycles per product); four keep the multiply-add units busy. The order is fixed, so the result is
+// the same on every run and thread.
+double support_dot(const std::vector<double>& w, const double* x) {
+  const std::size_t n = w.size(), whole = n - n % 4;
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  for (std::size_t i = 0; i < whole; i += 4) {
+    s0 += w[i] * x[i];
+    s1 += w[i + 1] * x[i + 1];
+    s2 += w[i + 2] * x[i + 2];
+    s3 += w[i + 3] * x[i + 3];
+  }
+  for (std::size_t i = whole; i < n; ++i) s0 += w[i] * x[i];
+  return (s0 + s1) + (s2 + s3);
+}
 
 std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations) {
   const auto weak = std::count_if(equations.begin(), equations.end(), [&](std::size_t e) { return model.equations[e].weak; });

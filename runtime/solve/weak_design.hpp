@@ -30,6 +30,10 @@ namespace sidc {
 // rows would not be commensurable: samples against subdomains).
 std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations);
 
+// sum_i w[i] * x[i] over a support (w.size() values from x): each row's integral, summed in a fixed
+// order, so that the result is the same on every run and thread.
+double support_dot(const std::vector<double>& w, const double* x);
+
 // Row j of an operation: its integral against subdomain j's test function (see above).
 class WeakValues final : public DesignValues {
  public:

@@ -173,18 +173,13 @@ TEST(WeakFit, NoisyRecordStaysClose) {
 // The rows come from g evaluated block by block (32,768 samples and the supports after them), not
 // on the whole window: on a record of 100,000 samples (four blocks, supports straddling each
 // boundary) every row equals, bit for bit, the integral of g evaluated on the whole window by
-// Evaluator, summed in weak_design.cpp's order (four running sums, added pairwise).
-double reference_dot(const std::vector<double>& w, const double* x) {
-  const std::size_t n = w.size(), whole = n - n % 4;
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  for (std::size_t i = 0; i < whole; i += 4) {
-    s0 += w[i] * x[i];
-    s1 += w[i + 1] * x[i + 1];
-    s2 += w[i + 2] * x[i + 2];
-    s3 += w[i + 3] * x[i + 3];
-  }
-  for (std::size_t i = whole; i < n; ++i) s0 += w[i] * x[i];
-  return (s0 + s1) + (s2 + s3);
+// Evaluator and summed by the same support_dot.
+TestFunctionGrid grid_every(std::size_t half_width, std::size_t spacing, std::size_t samples) {
+  TestFunctionGrid grid;
+  grid.half_width = half_width;
+  grid.degree = 10;
+  for (std::size_t centre = half_width; centre + half_width < samples; centre += spacing) grid.centres.push_back(centre);
+  return grid;
 }
 
 TEST(WeakValues, BlocksGiveTheWholeWindowsRowsBitForBit) {
@@ -198,10 +193,7 @@ TEST(WeakValues, BlocksGiveTheWholeWindowsRowsBitForBit) {
   const ir::Model& model = *c.integrated;
   const FitWindow window{10, record.time.size() - 11};
   Evaluator whole(record, model, EvaluationOptions{}, window), blocks(record, model, EvaluationOptions{}, window);
-  TestFunctionGrid grid;
-  grid.half_width = 150;
-  grid.degree = 10;
-  for (std::size_t centre = grid.half_width; centre + grid.half_width < window.size(); centre += 75) grid.centres.push_back(centre);
+  const TestFunctionGrid grid = grid_every(150, 75, window.size());
   ASSERT_GT(grid.centres.back(), 3 * (std::size_t{1} << 15));  // rows in every block
   WeakValues weak(blocks, grid);
   std::size_t compared = 0;
@@ -227,7 +219,7 @@ TEST(WeakValues, BlocksGiveTheWholeWindowsRowsBitForBit) {
         std::vector<double> g;
         ASSERT_FALSE(whole.evaluate_in_window(ir::canonical(terms), "g", g).has_value());
         const std::vector<double> w = test_function_weights(grid, k, record.step);
-        for (std::size_t j = 0; j < grid.centres.size(); ++j) expected[j] += reference_dot(w, g.data() + (grid.centres[j] - grid.half_width));
+        for (std::size_t j = 0; j < grid.centres.size(); ++j) expected[j] += support_dot(w, g.data() + (grid.centres[j] - grid.half_width));
       }
       for (std::size_t j = 0; j < rows.size(); ++j) ASSERT_EQ(rows[j], expected[j]) << print(term.operation) << ", row " << j;
       ++compared;
@@ -248,10 +240,7 @@ TEST(WeakValues, AValueThatIsNotFiniteIsNamedAsOnTheWholeWindow) {
   const ir::Model& model = *c.integrated;
   const FitWindow window{0, record.time.size() - 1};
   Evaluator whole(record, model, EvaluationOptions{}, window), blocks(record, model, EvaluationOptions{}, window);
-  TestFunctionGrid grid;
-  grid.half_width = 100;
-  grid.degree = 10;
-  for (std::size_t centre = grid.half_width; centre + grid.half_width < window.size(); centre += 50) grid.centres.push_back(centre);
+  const TestFunctionGrid grid = grid_every(100, 50, window.size());
   WeakValues weak(blocks, grid);
   for (const auto& term : model.equations[0].terms) {
     std::vector<double> rows(grid.centres.size());

@@ -14,6 +14,7 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/fitted_values.hpp"
+#include "ir/fix_parameters.hpp"
 #include "cli/output_check.hpp"
 #include "compiler/explicit_form_pass.hpp"
 #include "compiler/pipeline.hpp"
@@ -45,18 +46,21 @@ int run_export(const ExportArguments& a) {
   auto source = std::make_shared<const SourceFile>(model_name, j["model_source"].get<std::string>());
   CompileResult compiled = compile(source, {});
   if (!compiled.ok()) return fail(compiled.diagnostics.render_all(), exit_code::user_error);
-  const ir::Model& model = *compiled.normalized;
+  const ir::Model& as_compiled = *compiled.normalized;
 
-  std::vector<std::optional<double>> values(model.parameters.size());
+  std::vector<std::optional<double>> values(as_compiled.parameters.size());
   for (const auto& [name, value] : *fitted)
-    if (const int index = model.parameter_index(name); index >= 0) values[static_cast<std::size_t>(index)] = value;  // integration constants: not in the derivative form
+    if (const int index = as_compiled.parameter_index(name); index >= 0) values[static_cast<std::size_t>(index)] = value;  // integration constants: not in the derivative form
   std::string missing;
-  std::vector<double> known;
+  std::vector<double> all;
   for (std::size_t i = 0; i < values.size(); ++i) {
-    if (!values[i]) missing += (missing.empty() ? "`" : ", `") + model.parameters[i].name + "`";
-    known.push_back(values[i].value_or(0.0));
+    if (!values[i]) missing += (missing.empty() ? "`" : ", `") + as_compiled.parameters[i].name + "`";
+    all.push_back(values[i].value_or(0.0));
   }
   if (!missing.empty()) return fail(render(cli_diag::cannot_export("fit.json gives no finite estimate of " + missing)), exit_code::user_error);
+  // Nonlinear parameters (`sin(L*theta)`) are exported as the numbers fitted, like constants.
+  const ir::Model model = fix_nonlinear(as_compiled, all);
+  const std::vector<double> known = linear_part(as_compiled, all);
 
   const std::map<std::string, ExportLanguage> languages{{"c", ExportLanguage::c}, {"python", ExportLanguage::python}, {"latex", ExportLanguage::latex}};
   const ExportLanguage language = languages.at(a.language);

@@ -14,6 +14,9 @@ std::optional<std::vector<std::pair<std::string, double>>> fitted_values(const n
   };
   for (const auto& g : j["groups"])
     if (g.is_object()) take(g.value("parameters", nlohmann::json::array()), "estimate");
+  // Nonlinear parameters: the values the equation-error fit held them at.
+  const auto& nonlinear = j.contains("nonlinear_parameters") ? j["nonlinear_parameters"] : nlohmann::json();
+  if (nonlinear.is_object() && nonlinear.contains("parameters")) take(nonlinear["parameters"], "held");
   const auto& iv = j.contains("instrumental_variables") ? j["instrumental_variables"] : nlohmann::json();
   if (iv.is_object() && iv.value("termination", "") == "converged" && iv.contains("groups") && iv["groups"].is_array())
     for (const auto& g : iv["groups"])

@@ -24,6 +24,14 @@ struct Declarations {
   };
   std::vector<Constant> constants;  // in order: each may use the ones before it
 
+  // `param L = 1.2`: the guesses, lowered after the constants (a guess may use them). A family's
+  // guess is every member's: parameters [first, first + count).
+  struct Guess {
+    std::size_t first = 0, count = 1;
+    const ast::Expression* value = nullptr;
+  };
+  std::vector<Guess> guesses;
+
   struct InputDefinition {
     std::size_t signal;
     const ast::Expression* definition;

@@ -119,10 +119,12 @@ struct Declarer {
           continue;
         }
         out.families[item.name.name] = {from, to};
+        if (item.guess) out.guesses.push_back({out.model.parameters.size(), static_cast<std::size_t>(to - from + 1), &*item.guess});
         for (int k = from; k <= to; ++k)
-          out.model.parameters.push_back({fmt::format("{}[{}]", item.name.name, k), ir::Parameter::Origin::declared, where, -1, std::nullopt});
+          out.model.parameters.push_back({fmt::format("{}[{}]", item.name.name, k), ir::Parameter::Origin::declared, where, -1, std::nullopt, std::nullopt, false});
       } else {
-        out.model.parameters.push_back({item.name.name, ir::Parameter::Origin::declared, where, -1, std::nullopt});
+        if (item.guess) out.guesses.push_back({out.model.parameters.size(), 1, &*item.guess});
+        out.model.parameters.push_back({item.name.name, ir::Parameter::Origin::declared, where, -1, std::nullopt, std::nullopt, false});
       }
     }
   }

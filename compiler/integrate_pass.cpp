@@ -197,7 +197,7 @@ struct Integrator {
     e.known = antiderivative(e.known, initial);
     if (!initial && !trial) {  // eq. 2-2.4: the constant of this integration becomes a parameter
       model.parameters.push_back({next_constant_name(), ir::Parameter::Origin::integration_constant, e.span,
-                                  static_cast<int>(equation_index), std::nullopt});
+                                  static_cast<int>(equation_index), std::nullopt, std::nullopt, false});
       e.terms.push_back({static_cast<int>(model.parameters.size()) - 1, ir::number(1)});
     }
     ++e.integrations;

@@ -65,14 +65,28 @@ struct Context {
       : parameters(parameters_), signals(signals_), time(time_), what(what_), input(std::move(input_)), known_only(std::move(known_only_)) {}
 };
 
-bool has_parameter(const Sum& s, std::string* name = nullptr) {
+// A parameter among the sum's own factors (not nested: those were checked where they were
+// lowered) that `parameters` has no initial guess for: one linear least squares must fit.
+bool has_parameter(const Sum& s, std::string* name = nullptr, const std::vector<ir::Parameter>* parameters = nullptr) {
   for (const auto& t : s.terms)
     for (const auto& [f, power] : t.factors)
-      if (f.kind == FactorKind::parameter) {
+      if (f.kind == FactorKind::parameter && !(parameters && (*parameters)[static_cast<std::size_t>(f.order)].guess)) {
         if (name) *name = f.name;
         return true;
       }
   return false;
+}
+
+// Any parameter anywhere in the sum, nested ones too (guards and sign(): where a branch switches).
+bool has_nested_parameter(const Sum& s, std::string* name) {
+  bool found = false;
+  ir::walk_factors(s, [&](const Factor& f, const Term&) {
+    if (f.kind != FactorKind::parameter) return ir::Step::into;
+    *name = f.name;
+    found = true;
+    return ir::Step::stop;
+  });
+  return found;
 }
 
 // The nodes a product builds before like terms merge: every pair of terms, with both factor lists.
@@ -145,7 +159,7 @@ struct Lowerer {
       return {};
     }
     if (index < 0) {  // implicit: no `param` declaration in the file
-      decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1, std::nullopt});
+      decl.model.parameters.push_back({name, ir::Parameter::Origin::implicit, where, -1, std::nullopt, std::nullopt, false});
       index = static_cast<int>(decl.model.parameters.size()) - 1;
     }
     return ir::factor(Factor::plain(FactorKind::parameter, name, index), 1, where);
@@ -282,8 +296,8 @@ struct Lowerer {
     for (const auto& c : g.conditions) {
       Sum lhs = lower(c.lhs), rhs = lower(c.rhs);
       std::string name;
-      if (has_parameter(lhs, &name) || has_parameter(rhs, &name)) {
-        report(diag::nonlinear_parameter(span(c), name, "it stands inside a guard `[...]`"));
+      if (has_nested_parameter(lhs, &name) || has_nested_parameter(rhs, &name)) {
+        report(diag::parameter_in_switch(span(c), name, "inside a guard `[...]`"));
         return {};
       }
       ir::Relation r = c.op == "<" ? ir::Relation::less
@@ -385,10 +399,18 @@ struct Lowerer {
       if (!context.signals) return not_allowed(where, "int");
       return integral_of(argument);
     }
-    if (has_parameter(argument, &parameter_name)) {
+    if (has_parameter(argument, &parameter_name, &decl.model.parameters)) {
       report(diag::nonlinear_parameter(where, parameter_name, fmt::format("it stands inside `{}(...)`", name)));
       return {};
     }
+    if (name == "sign" && has_nested_parameter(argument, &parameter_name)) {
+      report(diag::parameter_in_switch(where, parameter_name, "inside `sign(...)`"));
+      return {};
+    }
+    return function_of(name, std::move(argument), where);
+  }
+
+  Sum function_of(const std::string& name, Sum argument, const Span& where) {
     if (auto n = argument.as_number()) return apply_to_number(name, *n, where);
     return ir::factor(Factor{FactorKind::function, name, 0, {}, {}, ir::share(std::move(argument)), {}}, 1, where);
   }
@@ -531,7 +553,7 @@ struct Lowerer {
         result = ir::multiply(result, operand);
       } else if (step.op == '/') {
         std::string name;
-        if (has_parameter(operand, &name)) {
+        if (has_parameter(operand, &name, &decl.model.parameters)) {
           report(diag::nonlinear_parameter(where, name, "it stands in a denominator"));
           return {};
         }
@@ -550,9 +572,13 @@ struct Lowerer {
         }
       } else {  // '^'
         std::string name;
-        if (has_parameter(operand, &name)) {
+        if (has_parameter(operand, &name, &decl.model.parameters)) {
           report(diag::nonlinear_parameter(where, name, "it stands in an exponent"));
           return {};
+        }
+        if (has_nested_parameter(operand, &name)) {  // y^p with p guessed: exp(p*log(y)), its definition for real p
+          result = function_of("exp", ir::multiply(operand, function_of("log", result, where)), where);
+          continue;
         }
         auto exponent = operand.as_number();
         if (!exponent) {
@@ -563,7 +589,7 @@ struct Lowerer {
           report(diag::number_overflows(where, "the exponent"));
           return {};
         }
-        if (has_parameter(result, &name) && !exponent->is_one()) {
+        if (has_parameter(result, &name, &decl.model.parameters) && !exponent->is_one()) {
           report(diag::nonlinear_parameter(where, name, fmt::format("it is raised to the power {}", exponent->to_string())));
           return {};
         }
@@ -737,6 +763,29 @@ std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement&
   return out;
 }
 
+// Marks the parameters with a guess that stand anywhere but as the one plain factor of a term:
+// inside a function, power or denominator, to a power, or beside another parameter. Only those
+// stay in the operations (Parameter::nonlinear); a guessed parameter that enters linearly
+// everywhere is fitted linearly, its guess unused.
+void mark_nonlinear(const Sum& s, std::vector<ir::Parameter>& parameters) {
+  const auto mark_nested = [&](const Sum& inner) {
+    ir::for_each_factor(inner, [&](const Factor& g) {
+      if (g.kind == FactorKind::parameter) parameters[static_cast<std::size_t>(g.order)].nonlinear = true;
+    });
+  };
+  for (const auto& t : s.terms) {
+    const auto count = std::count_if(t.factors.begin(), t.factors.end(), [](const auto& f) { return f.first.kind == FactorKind::parameter; });
+    for (const auto& [f, power] : t.factors) {
+      if (f.kind != FactorKind::parameter) {
+        ir::for_each_nested_sum(f, mark_nested);
+        continue;
+      }
+      ir::Parameter& p = parameters[static_cast<std::size_t>(f.order)];
+      if (p.guess && (power != 1 || count > 1)) p.nonlinear = true;
+    }
+  }
+}
+
 }  // namespace
 
 LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Diagnostics& diagnostics) {
@@ -746,6 +795,16 @@ LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Di
     if (!value) continue;
     if (auto n = value->as_number()) l.constants.emplace(c.name, *n);
     else diagnostics.add(diag::not_a_number(l.span(*c.value), fmt::format("constant `{}`", c.name)));
+  }
+  for (const auto& g : declarations.guesses) {
+    auto value = l.lower_in(*g.value, Context{false, false, false, "a parameter's initial guess", {}});
+    if (!value) continue;
+    const auto n = value->as_number();
+    if (!n || !std::isfinite(n->value())) {
+      diagnostics.add(diag::not_a_number(l.span(*g.value), "a parameter's initial guess"));
+      continue;
+    }
+    for (std::size_t k = 0; k < g.count; ++k) declarations.model.parameters[g.first + k].guess = *n;
   }
   for (const auto& d : declarations.input_definitions) {
     auto& signal = declarations.model.signals[d.signal];
@@ -759,6 +818,8 @@ LoweredModel lower_pass(Declarations declarations, const ParseResult& parsed, Di
     auto rhs = l.lower_in(e.rhs, Context{true, true, true, "", {}});
     if (lhs && rhs) out.equations.push_back({parsed.span(e), std::move(*lhs), std::move(*rhs), pending.integration});
   }
+  for (const auto& e : out.equations)
+    for (const Sum* side : {&e.lhs, &e.rhs}) mark_nonlinear(*side, declarations.model.parameters);
   if (declarations.equations.empty() && !diagnostics.has_errors())
     diagnostics.add(diag::empty_model(Span{parsed.source, 0, 0}));
   for (const auto& s : declarations.model.signals) {

@@ -13,7 +13,8 @@ std::optional<ParameterSplit> split_by_parameter(const ir::Sum& s, const ir::Mod
     int parameter = -1;
     ir::Term op{t.coefficient, {}, t.span};
     for (const auto& [f, power] : t.factors) {
-      if (f.kind != ir::FactorKind::parameter) {
+      // A nonlinear parameter (`sin(L*y)`, `L^2`) stays in the operation, held at a value by the runtime.
+      if (f.kind != ir::FactorKind::parameter || model.parameters[static_cast<std::size_t>(f.order)].nonlinear) {
         op.factors.push_back({f, power});
         continue;
       }

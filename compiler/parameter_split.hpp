@@ -2,8 +2,10 @@
 // multiplies, and the terms with no parameter. normalize_pass splits each equation this way, and
 // lower_pass each `plot` function.
 //
-// Relies on: lower_pass's canonical sums, parameters as plain factors. Guarantees: each term holds
-// at most one parameter, to the first power, or it is reported (`a1*a2*y`, `a1^2`) with its span;
+// Relies on: lower_pass's canonical sums, parameters as plain factors, Parameter::nonlinear marked.
+// Guarantees: each term holds at most one linear parameter, to the first power, or it is reported
+// (`a1*a2*y`, `a1^2`) with its span; nonlinear parameters (`param L = 1.2` inside `sin(L*y)`) stay
+// factors of the operations;
 // every offending term is reported, not only the first. Numeric factors stay in the operations.
 #pragma once
 

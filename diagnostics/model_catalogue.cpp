@@ -229,8 +229,16 @@ Diagnostic derivative_of_constant(const Span& where, std::string_view name) {
 
 Diagnostic nonlinear_parameter(const Span& where, std::string_view name, std::string_view how) {
   return error("nonlinear-parameter", where, fmt::format("parameter `{}` enters the equation nonlinearly: {}", name, how),
-               "each term may hold one parameter as a plain factor (`a1*y'^3`); sidc fits parameters by linear least squares "
-               "(thesis eq. 2-1.8). Give the product a parameter of its own");
+               fmt::format("each term may hold one parameter as a plain factor (`a1*y'^3`), which linear least squares fits "
+                           "(thesis eq. 2-1.8): give the product a parameter of its own, or give `{0}` an initial guess "
+                           "(`param {0} = 1.5`) and fit with `--refine`, which estimates it by the output error",
+                           name));
+}
+
+Diagnostic parameter_in_switch(const Span& where, std::string_view name, std::string_view place) {
+  return error("parameter-in-switch", where, fmt::format("parameter `{}` stands {}, where a branch switches", name, place),
+               "the time of a switch would move with the parameter, which neither the linear fit nor the refinement can "
+               "follow yet: write the threshold as a number or a constant (`const y0 = 0.2`), or move the parameter out of the condition");
 }
 
 Diagnostic no_known_term(const Span& where) {

@@ -3,12 +3,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "compiler/hold_check_pass.hpp"
 #include "compiler/integrate_pass.hpp"
 #include "compiler/pipeline.hpp"
 #include "compiler/weak_pass.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "ir/fix_parameters.hpp"
 #include "ir/queries.hpp"
 #include "ir/settings.hpp"
 #include "report/atomic_file.hpp"
@@ -47,7 +49,43 @@ std::string choose_the_form(FitRun& run) {
   return run.form_choice->report();
 }
 
+// The compiled models with the nonlinear parameters at `run.nonlinear->held`, from the models that
+// have them.
+void hold_nonlinear_parameters(FitRun& run) {
+  const NonlinearParameters& n = *run.nonlinear;
+  CompiledModel& c = run.compiled;
+  c.integrated = fix_nonlinear(n.integrated, n.held);
+  if (auto* form = std::get_if<ExplicitForm>(&n.explicit_form)) c.explicit_form = fix_nonlinear(*form, n.normalized, n.held);
+  else c.explicit_form = n.explicit_form;
+  c.normalized = fix_nonlinear(n.normalized, n.held);
+}
+
+// The values the equation-error fit holds the nonlinear parameters at: those of least G from
+// their guesses (variable_projection.hpp), in the form it fits (the weak form when the data
+// choose it: the first candidate).
+std::optional<Failure> project_nonlinear_parameters(FitRun& run) {
+  NonlinearParameters& n = *run.nonlinear;
+  const ir::Model searched = run.compiled.integrated.form_from_data ? rewritten_in_form(n.normalized, "weak") : n.integrated;
+  auto projection = variable_projection(searched, run.loaded.records, run.options);
+  if (auto* d = std::get_if<Diagnostic>(&projection)) return failure(*d);
+  n.projection = std::get<VariableProjectionSummary>(std::move(projection));
+  if (n.projection->moved() && std::isfinite(n.projection->G_best)) {
+    for (std::size_t k = 0; k < n.held.size(); ++k)
+      if (std::isfinite(n.projection->held[k])) n.held[k] = n.projection->held[k];
+    hold_nonlinear_parameters(run);
+  }
+  return std::nullopt;
+}
+
 }  // namespace
+
+std::vector<double> NonlinearParameters::with_held(const std::vector<double>& linear) const {
+  std::vector<double> out(normalized.parameters.size());
+  std::size_t next = 0;
+  for (std::size_t k = 0; k < out.size(); ++k)
+    out[k] = normalized.parameters[k].nonlinear ? held[k] : next < linear.size() ? linear[next++] : 0.0;
+  return out;
+}
 
 std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compiled, std::string model_path, const std::string& directory,
                                                            std::vector<RecordInput> inputs, FitSettings settings, const FitOutput& out) {
@@ -67,6 +105,14 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
     for (const auto& p : problems.items) out.warning(render(p));
     m.form_from_data = false;
     c.integrated = std::move(m);
+  }
+  // Nonlinear parameters: held at their guesses until run_fit searches for better values.
+  if (has_nonlinear_parameters(c.normalized) && c.explicit_form) {
+    NonlinearParameters n{c.normalized, c.integrated, *c.explicit_form, {}, nonlinear_guesses(c.normalized), std::nullopt};
+    for (const auto& p : c.normalized.parameters)
+      if (p.nonlinear) n.names.push_back(p.name);
+    run->nonlinear = std::move(n);
+    hold_nonlinear_parameters(*run);
   }
   const FitSettings& f = run->settings;
   if (f.stride != 1 && !f.local && !f.forget && !local_width_setting(c.integrated.settings))
@@ -103,6 +149,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   local_options.forget = a.forget;
   if (width)
     if (auto d = check_local_window(compiled.integrated, records, local_options)) return failure(*d, true);
+  if (run.nonlinear)
+    if (auto f = project_nonlinear_parameters(run)) return f;
   const std::string form_report = compiled.integrated.form_from_data ? choose_the_form(run) : "";
   const ir::Model& model = compiled.integrated;
   if (width)
@@ -121,6 +169,17 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
                        operator_report(summary.operators, o.evaluation, model);
   if (!is_static(model)) report += "\n";
   out.report(report + summary.full_report(model));
+  const bool refine_asked = a.refine || refine_by_simulation(compiled.normalized.settings);
+  if (run.nonlinear) {
+    out.report("\n" + run.nonlinear->projection->report() +
+               (refine_asked && summary.is_solution_usable() ? "The refinement below estimates them with the others.\n"
+                                                             : "Their estimates and intervals need --refine (or `set refine = simulation`), "
+                                                               "which fits them by the output error.\n"));
+    if (!refine_asked)
+      out.warning(fmt::format("sidc fit: warning: {} {} held by the equation-error fit, without an interval: add --refine to estimate {}",
+                              fmt::join(run.nonlinear->names, ", "), run.nonlinear->names.size() > 1 ? "are" : "is",
+                              run.nonlinear->names.size() > 1 ? "them" : "it"));
+  }
 
   // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;
   // validation solves with its estimate (or the refined one); residual tests and pictures stay
@@ -140,8 +199,11 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   // Output-error refinement (issue 15): from that estimate, the parameters whose solved equations
   // reproduce the fitted records best. A failure keeps the estimate it started from and says so.
   auto& refinement = run.refinement;
-  if ((a.refine || refine_by_simulation(compiled.normalized.settings)) && summary.is_solution_usable()) {
-    if (auto* d = std::get_if<Diagnostic>(&*compiled.explicit_form)) {
+  // With nonlinear parameters it refines the model that has them, from their guesses.
+  const ir::Model& refined_model = run.nonlinear ? run.nonlinear->normalized : compiled.normalized;
+  const std::variant<ExplicitForm, Diagnostic>& refined_form = run.nonlinear ? run.nonlinear->explicit_form : *compiled.explicit_form;
+  if (refine_asked && summary.is_solution_usable()) {
+    if (auto* d = std::get_if<Diagnostic>(&refined_form)) {
       refinement.emplace();
       refinement->message = "the equations cannot be solved for their highest derivatives (" + d->message + "); the equation-error estimate is kept";
     } else {
@@ -153,7 +215,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
       ro.to = o.to;
       std::vector<const SampledRecord*> fitted;
       for (const auto& r : records) fitted.push_back(&r);
-      auto refined = refine(compiled.normalized, std::get<ExplicitForm>(*compiled.explicit_form), fitted_estimate, fitted, ro);
+      auto refined = refine(refined_model, std::get<ExplicitForm>(refined_form), run.nonlinear ? run.nonlinear->with_held(fitted_estimate) : fitted_estimate,
+                            fitted, ro);
       if (auto* problem = std::get_if<Diagnostic>(&refined)) return failure(*problem);
       refinement = std::get<RefineSummary>(std::move(refined));
     }
@@ -173,7 +236,9 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     std::vector<const SampledRecord*> checked;
     for (const auto& r : records) checked.push_back(&r);
     for (const auto& r : extra) checked.push_back(&r);
-    run.validation = validate_fit(compiled.normalized, *compiled.explicit_form, summary, checked, records.size(), o.evaluation, a.validate_samples,
+    // The refined values are the refined model's (nonlinear parameters included).
+    const bool refined = refinement && refinement->improved();
+    run.validation = validate_fit(refined ? refined_model : compiled.normalized, refined ? refined_form : *compiled.explicit_form, summary, checked, records.size(), o.evaluation, a.validate_samples,
                                   a.initial_state,
                                   refinement && refinement->improved() ? &refinement->values
                                   : iv && iv->is_solution_usable()      ? &fitted_estimate
@@ -216,7 +281,8 @@ std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run
   return write_fit_files(directory, {run.compiled, run.model_path, run.summary, run.options, run.loaded.records, run.validation, run.residuals,
                                      run.form_choice ? &*run.form_choice : nullptr, run.refinement ? &*run.refinement : nullptr,
                                      run.instrumental_variables ? &*run.instrumental_variables : nullptr,
-                                     run.local ? &*run.local : nullptr});
+                                     run.local ? &*run.local : nullptr,
+                                     run.nonlinear && run.nonlinear->projection ? &*run.nonlinear->projection : nullptr});
 }
 
 bool write_pictures(const FitRun& run, const PictureRequest& request, std::vector<std::string>& written, std::string& error) {

@@ -31,6 +31,7 @@
 #include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/local_fit.hpp"
 #include "runtime/solve/residual_analysis.hpp"
+#include "runtime/solve/variable_projection.hpp"
 
 namespace sidc::driver {
 
@@ -62,9 +63,26 @@ struct FitOutput {
   std::function<void(const std::string& phase, std::size_t done, std::size_t total)> progress;
 };
 
+// A model's nonlinear parameters (`param L = 1.2` inside `sin(L*theta)`, ir/fix_parameters.hpp):
+// the models as compiled, with them, and the values the equation-error fit holds them at (found by
+// variable projection from the guesses), for the refinement that estimates them with the others.
+struct NonlinearParameters {
+  ir::Model normalized, integrated;
+  std::variant<ExplicitForm, Diagnostic> explicit_form;
+  std::vector<std::string> names;
+  std::vector<double> held;  // per parameter of `normalized`: the value held, NaN for a linear one
+  std::optional<VariableProjectionSummary> projection;
+  // The equation-error estimate (by `compiled.normalized`'s parameters) with the held values put
+  // back: one value per parameter of `normalized`, the refinement's start.
+  std::vector<double> with_held(const std::vector<double>& linear) const;
+};
+
 // One fit, from its model and records to everything it produced.
 struct FitRun {
-  CompiledModel compiled;  // `integrated` is the form fitted (after run_fit: chosen, when the model names none)
+  // `integrated` is the form fitted (after run_fit: chosen, when the model names none). With
+  // nonlinear parameters, every model here holds them at their guesses and has them no more.
+  CompiledModel compiled;
+  std::optional<NonlinearParameters> nonlinear;
   std::string model_path;  // as named in the report
   FitSettings settings;
   FitOptions options;

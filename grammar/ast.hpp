@@ -133,11 +133,13 @@ struct SignalDeclaration : x3::position_tagged {
   std::vector<SignalItem> signals;
 };
 
-// One item of `param a1, c[1..6]`: a single parameter or an indexed family.
+// One item of `param a1, c[1..6], L = 1.2`: a single parameter or an indexed family, with an
+// optional initial guess (a parameter that enters nonlinearly needs one).
 struct ParameterItem : x3::position_tagged {
   Identifier name;
   std::optional<int> from;  // both set for a family c[from..to]
   std::optional<int> to;
+  std::optional<Expression> guess;
 };
 
 struct ParameterDeclaration : x3::position_tagged {

@@ -76,8 +76,13 @@ struct AstPrinter {
   }
   void operator()(const ast::ParameterDeclaration& d) {
     out += "(param";
-    for (const auto& p : d.parameters)
+    for (const auto& p : d.parameters) {
       out += p.from ? fmt::format(" {}[{}..{}]", p.name.name, *p.from, *p.to) : " " + p.name.name;
+      if (p.guess) {
+        out += " = ";
+        (*this)(*p.guess);
+      }
+    }
     out += ")\n";
   }
   void operator()(const ast::ConstantDeclaration& d) {

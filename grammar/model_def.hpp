@@ -242,6 +242,7 @@ auto const assign_parameter_item = [](auto& ctx) {
     item.from = range->first;
     item.to = range->second;
   }
+  if (auto& guess = boost::fusion::at_c<2>(parts)) item.guess = std::move(*guess);
 };
 
 // The value is the raw text after `=`, without the comment and trailing blanks.
@@ -344,7 +345,7 @@ auto const signal_declaration_def = signal_kind > signal_items;
 
 auto const parameter_name_def = identifier;
 auto const family_range_def = lit('[') > integer > range_dots > integer > closing_bracket;
-auto const parameter_item_assembled_def = (parameter_name >> -family_range)[assign_parameter_item];
+auto const parameter_item_assembled_def = (parameter_name >> -family_range >> -(lit('=') > expression))[assign_parameter_item];
 auto const parameter_items_def = parameter_item >> *(lit(',') > parameter_item);
 auto const parameter_declaration_assembled_def = (keyword("param") > parameter_items)[assign_parameters];
 

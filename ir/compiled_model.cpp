@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <map>
 #include <set>
 #include <unordered_map>
 #include <utility>
@@ -164,6 +165,7 @@ constexpr int kMaxCompiledNesting = 256;
 struct Reader {
   std::shared_ptr<const SourceFile> source;
   std::set<std::string> signals;
+  std::map<std::string, int> nonlinear;  // the parameters that may stand inside operations, by name
   mutable int depth = 0;  // of the sum being read: functions, powers, der(), int() and guards nest
 
   Span span(const json& j) const {
@@ -207,7 +209,12 @@ struct Reader {
   ir::Factor factor(const json& j) const {
     const auto kind = kind_from(j.at("kind").get<std::string>());
     if (!kind) throw std::runtime_error("unknown factor kind `" + j.at("kind").get<std::string>() + "`");
-    if (*kind == FactorKind::parameter) throw std::runtime_error("a parameter factor inside an operation");
+    if (*kind == FactorKind::parameter) {
+      const auto name = j.at("name").get<std::string>();
+      const auto it = nonlinear.find(name);
+      if (it == nonlinear.end()) throw std::runtime_error("the parameter `" + name + "` stands inside an operation but is not marked nonlinear");
+      return ir::Factor::plain(FactorKind::parameter, name, it->second);
+    }
     if ((*kind == FactorKind::signal || *kind == FactorKind::initial_value) && !signals.count(j.at("name").get<std::string>()))
       throw std::runtime_error("a factor names the undeclared signal `" + j.at("name").get<std::string>() + "`");
     ir::Factor f{*kind, j.value("name", std::string()), j.contains("order") ? integer<int>(j, "order") : 0, {}, {}, {}, {}};
@@ -375,6 +382,9 @@ nlohmann::ordered_json to_json(const CompiledModel& c) {
     // Derived from the signals' units (compiler/unit_pass.cpp), for readers of the file; sidc
     // derives them again when it reads the file.
     if (p.unit) parameter["unit"] = to_string(*p.unit);
+    // Written only when given, so that files of models without them stay as they were.
+    if (p.guess) parameter["guess"] = number_json(*p.guess);
+    if (p.nonlinear) parameter["nonlinear"] = true;
     parameters.push_back(std::move(parameter));
   }
   j["parameters"] = std::move(parameters);
@@ -413,7 +423,7 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
     c.source = std::make_shared<const SourceFile>(j.at("source").at("path").get<std::string>(), j.at("source").at("text").get<std::string>());
     if (j.at("source").at("hash").get<std::string>() != source_hash(c.source->text))
       throw std::runtime_error("the source text does not match its hash");
-    Reader r{c.source, {}, 0};
+    Reader r{c.source, {}, {}, 0};
     for (const auto& s : j.at("signals")) r.signals.insert(s.at("name").get<std::string>());
     ir::Model& m = c.integrated;
     m.name = j.at("model").get<std::string>();
@@ -441,7 +451,14 @@ std::optional<CompiledModel> compiled_model_from_json(const nlohmann::ordered_js
                               origin == "implicit" ? ir::Parameter::Origin::implicit
                               : origin == "integration_constant" ? ir::Parameter::Origin::integration_constant
                                                                   : ir::Parameter::Origin::declared,
-                              r.span(p.at("span")), integer<int>(p, "equation"), std::nullopt});
+                              r.span(p.at("span")), integer<int>(p, "equation"), std::nullopt, std::nullopt, false});
+      ir::Parameter& added = m.parameters.back();
+      if (p.contains("guess")) added.guess = r.number(p.at("guess"));
+      added.nonlinear = p.value("nonlinear", false);
+      if (added.nonlinear && !added.guess) throw std::runtime_error("the nonlinear parameter `" + added.name + "` has no guess");
+      if (added.nonlinear && added.origin == ir::Parameter::Origin::integration_constant)
+        throw std::runtime_error("the integration constant `" + added.name + "` is marked nonlinear");
+      if (added.nonlinear) r.nonlinear.emplace(added.name, static_cast<int>(m.parameters.size()) - 1);
     }
     for (const auto& [name, value] : j.at("constants").items()) m.constants.emplace(name, r.number(value));
     for (const auto& [key, value] : j.at("settings").at("as_written").items()) {

@@ -14,12 +14,15 @@ Sum function_of(const std::string& name, const Sum& argument) {
   return ir::factor(Factor{FactorKind::function, name, 0, {}, {}, ir::share(argument), {}});
 }
 
-// What a derivative is taken with respect to: time (no signal), or one signal derivative y^(m)
-// held as an independent variable, as in the Jacobian of an ODE's right-hand side.
+// What a derivative is taken with respect to: time (no signal, no parameter), one signal
+// derivative y^(m) held as an independent variable, as in the Jacobian of an ODE's right-hand
+// side, or one parameter (its index), as in the sensitivity to a nonlinear parameter.
 struct Variable {
   const std::string* signal = nullptr;
   int order = 0;
   ir::NodeBudget* budget = nullptr;  // none: unbounded
+  int parameter = -1;
+  bool in_time() const { return signal == nullptr && parameter < 0; }
 };
 
 std::optional<Sum> derivative_of(const Sum& s, const Variable& v);
@@ -27,13 +30,14 @@ std::optional<Sum> derivative_of(const ir::Term& t, const Variable& v);
 
 // d/dt or the partial derivative of a single factor (power 1), or nullopt.
 std::optional<Sum> derivative_of(const Factor& f, const Variable& v) {
-  const bool in_time = v.signal == nullptr;
+  const bool in_time = v.in_time();
   switch (f.kind) {
     case FactorKind::parameter:
+      return v.parameter >= 0 && f.order == v.parameter ? ir::number(1) : Sum{};
     case FactorKind::window_start:
     case FactorKind::initial_value: return Sum{};
     case FactorKind::signal: {
-      if (!in_time) return f.name == *v.signal && f.order == v.order ? ir::number(1) : Sum{};
+      if (!in_time) return v.signal && f.name == *v.signal && f.order == v.order ? ir::number(1) : Sum{};
       Factor next = f;
       ++next.order;
       return ir::factor(next);
@@ -229,7 +233,7 @@ std::optional<Sum> differentiate(const Sum& s, int times) {
 std::optional<Sum> differentiate(const Sum& s, int times, ir::NodeBudget& budget) {
   Sum current = s;
   for (int k = 0; k < times; ++k) {
-    auto next = derivative_of(current, Variable{nullptr, 0, &budget});
+    auto next = derivative_of(current, Variable{nullptr, 0, &budget, -1});
     if (!next) return std::nullopt;
     current = std::move(*next);
   }
@@ -237,7 +241,11 @@ std::optional<Sum> differentiate(const Sum& s, int times, ir::NodeBudget& budget
 }
 
 std::optional<Sum> partial_derivative(const Sum& s, const std::string& signal, int order) {
-  return derivative_of(s, Variable{&signal, order, nullptr});
+  return derivative_of(s, Variable{&signal, order, nullptr, -1});
+}
+
+std::optional<ir::Sum> partial_derivative_by_parameter(const ir::Sum& s, int parameter) {
+  return derivative_of(s, Variable{nullptr, 0, nullptr, parameter});
 }
 
 }  // namespace sidc

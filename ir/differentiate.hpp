@@ -26,6 +26,10 @@ std::optional<ir::Sum> differentiate(const ir::Sum& s, int times, ir::NodeBudget
 // as output-error refinement's sensitivity equations need it (runtime/refine/). Guards and sign()
 // count as constant (0 between their switches); int() and der() have none (nullopt).
 std::optional<ir::Sum> partial_derivative(const ir::Sum& s, const std::string& signal, int order);
+// The partial derivative with respect to the parameter factor of index `parameter` (a nonlinear
+// parameter, `sin(L*y)` -> `cos(L*y)*y`), signals and t held constant: the refinement's
+// sensitivity to it. Guards and sign() hold no parameter (lower_pass refuses it there).
+std::optional<ir::Sum> partial_derivative_by_parameter(const ir::Sum& s, int parameter);
 
 // 1/u as a sum: inverted powers for a single term, else the factor (u)^-1.
 ir::Sum reciprocal(const ir::Sum& u);

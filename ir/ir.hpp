@@ -144,6 +144,13 @@ struct Parameter {
   // Derived by compiler/unit_pass.cpp from the signals' units; nullopt where some factor of its
   // term, or its equation's parameter-free side, has none.
   std::optional<Unit> unit;
+  // `param L = 1.2`: the initial guess (a number; constants allowed in the model text).
+  std::optional<Number> guess;
+  // Set by lower_pass: the parameter stands inside a function, a power, a denominator or beside
+  // another parameter (`sin(L*theta)`, `exp(-k*t)`, `y^p`), so it cannot be fitted by linear least
+  // squares. It then stays a factor inside the operations (normalize_pass does not split it off):
+  // the equation-error fit holds it at its guess (ir/fix_parameters.hpp) and `--refine` estimates it.
+  bool nonlinear = false;
 };
 
 // How an equation is to be integrated (integrate_pass.cpp).

@@ -191,10 +191,15 @@ std::string print(const ir::Model& m) {
       const std::string family = name.substr(0, bracket);
       const int first = std::stoi(name.substr(bracket + 1));
       std::size_t j = i + 1;
-      while (j < m.parameters.size() && m.parameters[j].name == fmt::format("{}[{}]", family, first + static_cast<int>(j - i))) ++j;
+      const auto& guess = m.parameters[i].guess;
+      while (j < m.parameters.size() && m.parameters[j].name == fmt::format("{}[{}]", family, first + static_cast<int>(j - i)) &&
+             m.parameters[j].guess.has_value() == guess.has_value() && (!guess || *m.parameters[j].guess == *guess))
+        ++j;
       item = j - i > 1 ? fmt::format("{}[{}..{}]", family, first, first + static_cast<int>(j - i) - 1) : name;
+      if (guess) item += " = " + guess->to_string();
       i = j;
     } else {
+      if (m.parameters[i].guess) item += " = " + m.parameters[i].guess->to_string();
       ++i;
     }
     params += (params.empty() ? "" : ", ") + item;

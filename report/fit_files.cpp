@@ -356,6 +356,12 @@ nlohmann::ordered_json refinement_json(const RefineSummary& r) {
           {"parameters", std::move(parameters)}, {"records", std::move(records)}};
 }
 
+nlohmann::ordered_json nonlinear_json(const VariableProjectionSummary& v) {
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::array();
+  for (std::size_t k = 0; k < v.names.size(); ++k) parameters.push_back({{"name", v.names[k]}, {"guess", v.guesses[k]}, {"held", v.values[k]}});
+  return {{"method", "variable projection"}, {"fits", v.fits}, {"G_guess", v.G_guess}, {"G_held", v.G_best}, {"parameters", std::move(parameters)}};
+}
+
 }  // namespace
 
 std::vector<std::string> fit_file_paths(const std::string& directory) {
@@ -382,6 +388,7 @@ nlohmann::ordered_json fit_document(const FitFiles& f) {
   json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
   json["instrumental_variables"] = f.instrumental_variables ? instrumental_variables_json(*f.instrumental_variables) : nlohmann::ordered_json(nullptr);
   json["local"] = f.local ? local_json(*f.local) : nlohmann::ordered_json(nullptr);
+  json["nonlinear_parameters"] = f.nonlinear ? nonlinear_json(*f.nonlinear) : nlohmann::ordered_json(nullptr);
   non_finite_as_strings(json);
   return json;
 }

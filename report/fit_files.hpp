@@ -22,6 +22,7 @@
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/local_fit.hpp"
+#include "runtime/solve/variable_projection.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 
 namespace sidc {
@@ -60,6 +61,10 @@ struct FitFiles {
   // The local fits (`--local`, `--forget`, `set local`); null otherwise (fit.json's `local` is then
   // null and no local.csv is written).
   const LocalFitSummary* local = nullptr;
+  // The values the equation-error fit held the nonlinear parameters at (`param L = 1.2` inside
+  // `sin(L*theta)`; variable_projection.hpp); null when the model has none (fit.json's
+  // `nonlinear_parameters` is then null).
+  const VariableProjectionSummary* nonlinear = nullptr;
 };
 
 // local.csv: one row per window (record, when several, then t_center, each parameter and its

@@ -235,7 +235,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
   summary.values = linear;
   for (std::size_t q = 0; q < normalized.parameters.size(); ++q)
     summary.parameters.push_back({normalized.parameters[q].name, linear[q], linear[q], std::numeric_limits<double>::quiet_NaN(),
-                                  parameter_unit(normalized, normalized.parameters[q].name)});
+                                  parameter_unit(normalized, normalized.parameters[q].name), normalized.parameters[q].nonlinear});
 
   ValidationOptions v;
   v.substeps = options.substeps > 0 ? options.substeps : 4;  // for the start's estimate; the refinement's own is chosen below
@@ -538,6 +538,11 @@ std::string RefineSummary::report() const {
                        known ? fmt::format("[{:.7g}, {:.7g}]", q.refined - 1.96 * q.standard_error, q.refined + 1.96 * q.standard_error) : "-",
                        q.unit.empty() ? "" : "  " + q.unit);
   }
+  std::string held;
+  for (const auto& q : parameters)
+    if (q.nonlinear) held += (held.empty() ? "" : ", ") + q.name;
+  if (!held.empty())
+    out += fmt::format("  {}: entering nonlinearly, the equation-error column gives the value that fit held it at\n", held);
   if (std::any_of(records.begin(), records.end(), [](const RefinedRecord& r) { return r.segments > 1; }))
     out += fmt::format("  multiple shooting{}: each segment solved from its own initial state, the segments joined by the\n"
                        "  continuity of the whole state (weighted {:g} times a sample's output error); the largest jump left at a join\n"

@@ -61,6 +61,7 @@ struct RefinedParameter {
   double refined = 0;         // the output-error estimate (the linear one when the refinement failed)
   double standard_error = 0;  // Gauss-Newton; NaN when J^T J is singular
   std::string unit;           // as the fit table prints it; "" when the model gives none
+  bool nonlinear = false;     // `linear` is the value the equation-error fit held it at (it enters nonlinearly)
 };
 
 struct RefinedRecord {

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "ir/differentiate.hpp"
+#include "ir/fix_parameters.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "diagnostics/model_catalogue.hpp"
 #include "runtime/operators/operator_choice.hpp"
@@ -64,8 +65,10 @@ double interpolate_cubic(const std::vector<double>& time, const std::vector<doub
 
 class System {
  public:
-  // Returns a Diagnostic when something of the model has no value at a point.
-  std::optional<Diagnostic> build(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& o) {
+  // Returns a Diagnostic when something of the model has no value at a point. `form` has its
+  // nonlinear parameters substituted; `full` (with sensitivities) still holds them as factors, for
+  // the partial derivatives by them.
+  std::optional<Diagnostic> build(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& o, const ExplicitForm* full = nullptr) {
     form_ = &form;
     compile_options_.initial_value = o.initial_value;
     compile_options_.switching_functions = form.switching_functions;
@@ -125,6 +128,8 @@ class System {
         if (auto d = partials(form.rest[i], rest_partial_[i])) return d;
       }
     }
+    if (sensitivities_ && full)
+      if (auto d = nonlinear_partials(model, *full, o)) return d;
     for (const auto& g : form.switching_functions) {
       auto c = compile_point_sum(g, layout_, compile_options_);
       if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
@@ -346,6 +351,41 @@ class System {
     }
   }
 
+  // d/dL of each side for each nonlinear parameter L (`sin(L*theta)` -> `cos(L*theta)*theta`, times
+  // the linear parameter it stands beside), derived from the unsubstituted form and evaluated at
+  // the run's values: the sensitivity equations' inhomogeneous column for L, as a side's part is
+  // for a linear parameter.
+  std::optional<Diagnostic> nonlinear_partials(const ir::Model& model, const ExplicitForm& full, const SimulateOptions& o) {
+    const std::size_t k = full.outputs.size();
+    rest_nonlinear_.assign(k, {});
+    coefficient_nonlinear_.assign(k, std::vector<Weighted>(k));
+    const auto by = [&](const ParametricSum& p, int q, Weighted& out) -> std::optional<Diagnostic> {
+      ir::Sum total;
+      auto add = [&](double w, const ir::Sum& s) -> bool {
+        if (s.empty() || w == 0) return true;
+        auto d = partial_derivative_by_parameter(s, q);
+        if (!d) return false;
+        total = ir::add(total, w == 1 ? *d : ir::scale(*d, Number::real(w)));
+        return true;
+      };
+      bool ok = add(1.0, p.constant);
+      for (const auto& t : p.terms) ok = ok && add(o.parameters[static_cast<std::size_t>(t.parameter)], t.operation);
+      const auto& parameter = model.parameters[static_cast<std::size_t>(q)];
+      if (!ok) return diag::simulate_estimated_derivative(parameter.span, parameter.name);
+      if (total.empty()) return std::nullopt;
+      return out.add(1.0, q, substitute_parameters(total, o.parameters), layout_, compile_options_);
+    };
+    for (std::size_t q = 0; q < model.parameters.size(); ++q) {
+      if (!model.parameters[q].nonlinear) continue;
+      for (std::size_t i = 0; i < k; ++i) {
+        for (std::size_t j = 0; j < k; ++j)
+          if (auto d = by(full.coefficient[i][j], static_cast<int>(q), coefficient_nonlinear_[i][j])) return d;
+        if (auto d = by(full.rest[i], static_cast<int>(q), rest_nonlinear_[i])) return d;
+      }
+    }
+    return std::nullopt;
+  }
+
   std::vector<std::size_t> state_offset_;
   std::size_t evaluations = 0;
   std::optional<std::string> trouble;
@@ -373,11 +413,19 @@ class System {
       for (std::size_t m = 0; m < n; ++m)
         if (!rest_partial_[i][m].empty()) g[m] += rest_partial_[i][m].evaluate(at);
       add_parameters(rest_[i], 1.0);
+      if (!rest_nonlinear_.empty() && !rest_nonlinear_[i].empty()) {
+        rest_nonlinear_[i].evaluate(at);
+        add_parameters(rest_nonlinear_[i], 1.0);
+      }
       for (std::size_t j = 0; j < k; ++j) {
         const double zj = z_(static_cast<Eigen::Index>(j));
         for (std::size_t m = 0; m < n; ++m)
           if (!coefficient_partial_[i][j][m].empty()) g[m] += zj * coefficient_partial_[i][j][m].evaluate(at);
         add_parameters(coefficient_[i][j], zj);
+        if (!coefficient_nonlinear_.empty() && !coefficient_nonlinear_[i][j].empty()) {
+          coefficient_nonlinear_[i][j].evaluate(at);
+          add_parameters(coefficient_nonlinear_[i][j], zj);
+        }
       }
       const double* sensitivity = state + n;  // column q of S starts at q * n
       for (std::size_t q = 0; q < q_count; ++q)
@@ -444,6 +492,8 @@ class System {
   std::size_t parameters_ = 0;
   std::vector<std::vector<std::vector<Weighted>>> coefficient_partial_;  // [i][j][state component]
   std::vector<std::vector<Weighted>> rest_partial_;                      // [i][state component]
+  std::vector<std::vector<Weighted>> coefficient_nonlinear_;  // [i][j]: one part per nonlinear parameter
+  std::vector<Weighted> rest_nonlinear_;                      // [i]: the same
   Eigen::MatrixXd a_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
   Eigen::VectorXd z_;      // the highest derivatives
   std::vector<double> g_, c_;  // the sensitivity equations' d(A z + r)/dx (k x n) and right-hand side (k x Q), row-major
@@ -553,8 +603,12 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
   if (std::string why; !o.is_valid(&why)) throw std::logic_error("simulate: " + why);
   if (o.parameters.size() != normalized.parameters.size())
     throw std::logic_error(fmt::format("simulate: {} parameter values for {} parameters", o.parameters.size(), normalized.parameters.size()));
+  // Nonlinear parameters (`sin(L*theta)`) become numbers for the run; the sensitivities to them
+  // come from the form that still holds them.
+  const bool nonlinear = has_nonlinear_parameters(normalized);
+  const ExplicitForm substituted = nonlinear ? substitute_nonlinear(form, normalized, o.parameters) : ExplicitForm{};
   System system;
-  if (auto d = system.build(normalized, form, o)) return *d;
+  if (auto d = system.build(normalized, nonlinear ? substituted : form, o, nonlinear ? &form : nullptr)) return *d;
   // The summary's arrays are refilled in place: a refinement runs the same record dozens of times,
   // and fresh arrays of its size cost more in page faults than the run in arithmetic.
   {

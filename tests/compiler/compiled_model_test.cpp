@@ -226,7 +226,7 @@ TEST(CompiledModelSchema, EveryGoldenModelValidates) {
   EXPECT_GE(validated, 100u);
   // The corpus reaches every factor kind a file can hold, so each kind's schema has been applied.
   EXPECT_EQ(kinds, (std::set<std::string>{"signal", "initial_value", "window_start", "time", "elapsed", "function", "power",
-                                          "derivative", "integral", "guard"}));
+                                          "derivative", "integral", "guard", "parameter"}));
   EXPECT_EQ(origins, (std::set<std::string>{"declared", "implicit", "integration_constant"}));
 }
 
@@ -293,7 +293,7 @@ TEST(CompiledModelSchema, RejectsDocumentsBrokenOnPurpose) {
       {"extra property deep down", [&](json& j) { j[first_factor]["note"] = 1; }, "unexpected property \"note\""},
       {"wrong format", [](json& j) { j["format"] = "sidc-model"; }, "/format: expected \"sidc-compiled-model\""},
       {"other version", [](json& j) { j["version"] = 1; }, "/version: expected 2"},
-      {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, "matches none of the 11 alternatives"},
+      {"unknown factor kind", [&](json& j) { j[first_factor]["kind"] = "spline"; }, "matches none of the 12 alternatives"},
       {"zero power", [&](json& j) { j[first_factor]["power"] = 0; }, "/power"},
       {"zero denominator", [](json& j) { j["equations"][0]["known"]["terms"][0]["coefficient"]["den"] = 0; }, "/den: 0 is below"},
       {"an infinite coefficient (written as null)", [](json& j) { j["equations"][0]["known"]["terms"][0]["coefficient"] = {{"real", nullptr}}; },
@@ -520,7 +520,8 @@ TEST(CompiledModelFile, ReaderRefusesValuesItWouldMisread) {
       {"unknown parameter origin", [](json& j) { j["parameters"][0]["origin"] = "declard"; }},
       {"unknown constants mode", [](json& j) { j["equations"][0]["constants"] = "initail"; }},
       {"power 0", [&](json& j) { j[factor]["power"] = 0; }},
-      {"a parameter factor (its index is not written)", [&](json& j) { j[factor] = {{"kind", "parameter"}, {"name", "a1"}, {"power", 1}}; }},
+      {"a factor of a parameter not marked nonlinear", [&](json& j) { j[factor] = {{"kind", "parameter"}, {"name", "a1"}, {"power", 1}}; }},
+      {"a nonlinear parameter without a guess", [](json& j) { j["parameters"][0]["nonlinear"] = true; }},
       {"a factor of an undeclared signal", [&](json& j) { j[factor]["name"] = "w"; }},
       {"unknown setting", [](json& j) { j["settings"]["as_written"]["derivativ"] = "savgol(7, 3)"; }},
       {"invalid setting value", [](json& j) { j["settings"]["as_written"]["every"] = "many"; }},

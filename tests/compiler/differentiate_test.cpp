@@ -87,6 +87,20 @@ TEST(PartialDerivative, ProductAndPowerRulesHoldOtherSlotsConstant) {
   EXPECT_TRUE(partial_derivative(s, "y", 2)->empty());
 }
 
+// By a nonlinear parameter (`param L = 1.2`), signals held constant: the refinement's
+// sensitivity to it. Other parameters, signals and t are constants.
+TEST(PartialDerivative, ByANonlinearParameter) {
+  const auto r = testing::compile_text("input x\noutput y\nparam a, L = 1.2, k = 0.1\na*y'' + sin(L*y) + exp(-k*t)*L*y' = x\n",
+                                       {{}, "normalize"});
+  ASSERT_TRUE(r.ok()) << r.diagnostics.render_all();
+  const ir::Sum& known = r.normalized->equations[0].known;
+  EXPECT_EQ(print(known), "-L*y'*exp(-k*t) + x - sin(L*y)");
+  EXPECT_EQ(print(*partial_derivative_by_parameter(known, 1)), "-y'*exp(-k*t) - y*cos(L*y)");
+  EXPECT_EQ(print(*partial_derivative_by_parameter(known, 2)), "L*y'*t*exp(-k*t)");
+  EXPECT_TRUE(partial_derivative_by_parameter(known, 0)->empty());
+  EXPECT_FALSE(partial_derivative_by_parameter(ir::factor(ir::Factor{ir::FactorKind::integral, "", 0, {}, {}, ir::share(known), {}}), 1));
+}
+
 TEST(PartialDerivative, ChainRuleGuardsAndSignsAreConstantBetweenSwitches) {
   const auto r = testing::compile_text("input x\noutput y\nparam a, b, c\na*y'' + b*sin(y*y') + c*[y' > 0]*y'*y = x\n", {{}, "normalize"});
   ASSERT_TRUE(r.ok()) << r.diagnostics.render_all();

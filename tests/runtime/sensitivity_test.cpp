@@ -102,6 +102,21 @@ TEST(Sensitivity, HeldInput) {
   EXPECT_LT(largest_sensitivity_error(m, o), 1e-6);
 }
 
+// Nonlinear parameters (`param L = 1.2`): their columns come from the symbolic partial derivative
+// by the parameter (ir/differentiate.hpp), in a linear parameter's operation (k*sin(L*y)), in the
+// parameter-free side (exp(-r*t)*y) and in the coefficient of y'' (m*(1 + g*y^2)).
+TEST(Sensitivity, NonlinearParameters) {
+  const ir::Model m = normalized(
+      "input x = cos(1.2*t)\noutput y\nparam m, c, k, L = 1, r = 0.5, g = 0.1\n"
+      "m*(1 + g*y^2)*y'' + c*y' + k*sin(L*y) + exp(-r*t)*y = x\n");
+  ASSERT_TRUE(m.parameters[3].nonlinear && m.parameters[4].nonlinear && m.parameters[5].nonlinear);
+  SimulateOptions o;
+  o.parameters = {1.0, 0.1, 2.0, 0.8, 0.3, 0.2};
+  o.initial["y"] = {0.5, -0.2};
+  o.time = grid(0, 20, 0.05);
+  EXPECT_LT(largest_sensitivity_error(m, o), 1e-6);
+}
+
 // Coulomb friction: the right-hand side jumps at every reversal of y', and the sensitivities jump
 // with it (the switch time moves with every parameter); differences of whole runs, whose switches
 // are located to 1e-13, see that jump.

@@ -63,12 +63,16 @@ void hold_nonlinear_parameters(FitRun& run) {
 // The values the equation-error fit holds the nonlinear parameters at: those of least G from
 // their guesses (variable_projection.hpp), in the form it fits (the weak form when the data
 // choose it: the first candidate).
-std::optional<Failure> project_nonlinear_parameters(FitRun& run) {
+std::optional<Failure> project_nonlinear_parameters(FitRun& run, const FitOutput& out) {
   NonlinearParameters& n = *run.nonlinear;
   const ir::Model searched = run.compiled.integrated.form_from_data ? rewritten_in_form(n.normalized, "weak") : n.integrated;
   auto projection = variable_projection(searched, run.loaded.records, run.options);
   if (auto* d = std::get_if<Diagnostic>(&projection)) return failure(*d);
   n.projection = std::get<VariableProjectionSummary>(std::move(projection));
+  for (const auto& name : n.projection->at_edge)
+    out.warning(fmt::format("sidc fit: warning: nonlinear parameter `{}` ended at the edge of the range searched from its guess "
+                            "(1/8 to 8 times it): the data may not determine it, or the guess is far off",
+                            name));
   if (n.projection->moved() && std::isfinite(n.projection->G_best)) {
     for (std::size_t k = 0; k < n.held.size(); ++k)
       if (std::isfinite(n.projection->held[k])) n.held[k] = n.projection->held[k];
@@ -150,7 +154,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   if (width)
     if (auto d = check_local_window(compiled.integrated, records, local_options)) return failure(*d, true);
   if (run.nonlinear)
-    if (auto f = project_nonlinear_parameters(run)) return f;
+    if (auto f = project_nonlinear_parameters(run, out)) return f;
+  const bool form_from_data = compiled.integrated.form_from_data;
   const std::string form_report = compiled.integrated.form_from_data ? choose_the_form(run) : "";
   const ir::Model& model = compiled.integrated;
   if (width)
@@ -159,6 +164,15 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   auto result = fit(model, records, o);
   if (auto* d = std::get_if<Diagnostic>(&result)) return failure(*d);
   run.summary = std::get<FitSummary>(std::move(result));
+  if (run.nonlinear && run.nonlinear->projection) {
+    // The intervals with the held values' own uncertainty, in the form fitted (nonlinear_intervals).
+    NonlinearParameters& n = *run.nonlinear;
+    const std::string form = run.form_choice ? run.form_choice->scores[run.form_choice->chosen].name : form_from_data ? "weak" : "";
+    const NonlinearIntervals intervals =
+        nonlinear_intervals(form.empty() ? n.integrated : rewritten_in_form(n.normalized, form), records, o, n.held, run.summary);
+    n.projection->standard_errors = intervals.standard_errors;
+    n.projection->interval_note = intervals.note;
+  }
   const FitSummary& summary = run.summary;
   for (const auto& r : summary.operators)
     for (const auto& w : r.warnings) out.warning(render(w));
@@ -171,14 +185,21 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   out.report(report + summary.full_report(model));
   const bool refine_asked = a.refine || refine_by_simulation(compiled.normalized.settings);
   if (run.nonlinear) {
-    out.report("\n" + run.nonlinear->projection->report() +
-               (refine_asked && summary.is_solution_usable() ? "The refinement below estimates them with the others.\n"
-                                                             : "Their estimates and intervals need --refine (or `set refine = simulation`), "
-                                                               "which fits them by the output error.\n"));
-    if (!refine_asked)
-      out.warning(fmt::format("sidc fit: warning: {} {} held by the equation-error fit, without an interval: add --refine to estimate {}",
-                              fmt::join(run.nonlinear->names, ", "), run.nonlinear->names.size() > 1 ? "are" : "is",
-                              run.nonlinear->names.size() > 1 ? "them" : "it"));
+    // Static models: the equation error is the output error, nothing to refine. Dynamic ones: the
+    // equation error is biased on noisy records, the refinement is not.
+    const VariableProjectionSummary& v = *run.nonlinear->projection;
+    const bool intervals = std::any_of(v.standard_errors.begin(), v.standard_errors.end(), [](double e) { return std::isfinite(e); });
+    std::string next;
+    const char* them = run.nonlinear->names.size() > 1 ? "them" : "it";
+    if (refine_asked && summary.is_solution_usable()) next = fmt::format("The refinement below estimates {} with the others.\n", them);
+    else if (!is_static(model))
+      next = fmt::format("--refine (or `set refine = simulation`) estimates {} with the others by the output error, free of the equation\n"
+                         "error's bias on noisy records.\n", them);
+    out.report("\n" + v.report() + next);
+    if (!intervals && !(refine_asked && summary.is_solution_usable()))
+      out.warning(fmt::format("sidc fit: warning: {} {} held by the equation-error fit without an interval ({}){}",
+                              fmt::join(run.nonlinear->names, ", "), run.nonlinear->names.size() > 1 ? "are" : "is", v.interval_note,
+                              is_static(model) ? "" : fmt::format(": add --refine to estimate {} with an interval", them)));
   }
 
   // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;

@@ -358,8 +358,13 @@ nlohmann::ordered_json refinement_json(const RefineSummary& r) {
 
 nlohmann::ordered_json nonlinear_json(const VariableProjectionSummary& v) {
   nlohmann::ordered_json parameters = nlohmann::ordered_json::array();
-  for (std::size_t k = 0; k < v.names.size(); ++k) parameters.push_back({{"name", v.names[k]}, {"guess", v.guesses[k]}, {"held", v.values[k]}});
-  return {{"method", "variable projection"}, {"fits", v.fits}, {"G_guess", v.G_guess}, {"G_held", v.G_best}, {"parameters", std::move(parameters)}};
+  for (std::size_t k = 0; k < v.names.size(); ++k)
+    parameters.push_back({{"name", v.names[k]}, {"guess", v.guesses[k]}, {"held", v.values[k]},
+                          {"standard_error", k < v.standard_errors.size() ? finite_or_null(v.standard_errors[k]) : nlohmann::ordered_json(nullptr)}});
+  nlohmann::ordered_json edge = nlohmann::ordered_json::array();
+  for (const auto& name : v.at_edge) edge.push_back(name);
+  return {{"method", "variable projection"}, {"fits", v.fits},       {"G_guess", v.G_guess},           {"G_held", v.G_best},
+          {"at_edge", std::move(edge)},       {"interval_note", v.interval_note}, {"parameters", std::move(parameters)}};
 }
 
 }  // namespace

@@ -1,9 +1,11 @@
 #include "runtime/solve/variable_projection.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <optional>
 
 #include "ir/fix_parameters.hpp"
 
@@ -49,14 +51,21 @@ class Objective {
 };
 
 // Nelder-Mead (Lagarias et al., SIAM J. Optim. 9(1), 1998: reflection 1, expansion 2, contraction
-// 1/2, shrink 1/2) from `start`, first simplex steps `step`; `best` and `best_value` updated in place.
-void nelder_mead(Objective& f, std::vector<double>& best, double& best_value, const std::vector<double>& step) {
+// 1/2, shrink 1/2) from `best`, first simplex steps `step`, every point kept within [low, high];
+// `best` and `best_value` updated in place.
+void nelder_mead(Objective& f, std::vector<double>& best, double& best_value, const std::vector<double>& step, const std::vector<double>& low,
+                 const std::vector<double>& high) {
   const std::size_t m = best.size();
+  const auto inside = [&](std::vector<double> v) {
+    for (std::size_t i = 0; i < m; ++i) v[i] = std::clamp(v[i], low[i], high[i]);
+    return v;
+  };
   std::vector<std::vector<double>> x{best};
   std::vector<double> fx{best_value};
   for (std::size_t k = 0; k < m; ++k) {
     auto v = best;
-    v[k] += step[k];
+    v[k] += v[k] + step[k] <= high[k] ? step[k] : -step[k];
+    v = inside(v);
     x.push_back(v);
     fx.push_back(f.value(v));
   }
@@ -78,7 +87,7 @@ void nelder_mead(Objective& f, std::vector<double>& best, double& best_value, co
     const auto along = [&](double t) {
       std::vector<double> v(m);
       for (std::size_t i = 0; i < m; ++i) v[i] = centre[i] + t * (x[hi][i] - centre[i]);
-      return v;
+      return inside(v);
     };
     auto r = along(-1.0);
     const double fr = f.value(r);
@@ -141,9 +150,19 @@ std::variant<VariableProjectionSummary, Diagnostic> variable_projection(const ir
         if (g < best_value) best_value = g, best = v;
       }
   }
-  std::vector<double> step(best.size());
-  for (std::size_t k = 0; k < best.size(); ++k) step[k] = best[k] != 0 ? 0.1 * std::abs(best[k]) : 0.1;
-  if (std::isfinite(best_value)) nelder_mead(f, best, best_value, step);
+  // The search stays within the scanned range: beyond it a value is rather a sign that the data do not
+  // determine the parameter (sin(L*y) beside a*y, as L goes to 0) than an estimate.
+  std::vector<double> step(best.size()), low(best.size()), high(best.size());
+  for (std::size_t k = 0; k < best.size(); ++k) {
+    step[k] = best[k] != 0 ? 0.1 * std::abs(best[k]) : 0.1;
+    const double g = out.guesses[k];
+    low[k] = g > 0 ? g / 8 : g < 0 ? 8 * g : -8.0;
+    high[k] = g > 0 ? 8 * g : g < 0 ? g / 8 : 8.0;
+  }
+  if (std::isfinite(best_value)) nelder_mead(f, best, best_value, step, low, high);
+  for (std::size_t k = 0; k < best.size(); ++k)
+    if (std::abs(best[k] - low[k]) <= 1e-6 * std::abs(low[k]) || std::abs(best[k] - high[k]) <= 1e-6 * std::abs(high[k]))
+      out.at_edge.push_back(out.names[k]);
   out.values = best;
   out.G_best = best_value;
   out.fits = f.fits;
@@ -162,13 +181,134 @@ std::string VariableProjectionSummary::report() const {
     return fmt::format("Nonlinear parameters: no value near the initial guess{} ({}) gives a usable equation-error fit ({} fits tried);\n"
                        "the fit above holds them at the guess{}.\n",
                        names.size() > 1 ? "es" : "", guesses_text, fits, names.size() > 1 ? "es" : "");
+  std::string edge;
+  for (const auto& name : at_edge) edge += (edge.empty() ? "" : ", ") + name;
+  std::string errors;
+  for (std::size_t k = 0; k < standard_errors.size() && k < names.size(); ++k)
+    if (std::isfinite(standard_errors[k])) errors += fmt::format("{}{} {:.3g}", errors.empty() ? "" : ", ", names[k], standard_errors[k]);
+  if (!errors.empty())
+    errors = fmt::format("  Standard error{} {} (from the curvature of G over {}); the intervals above include {} uncertainty and,\n"
+                         "  like them, assume independent rows.\n",
+                         names.size() > 1 ? "s:" : " of", errors, names.size() > 1 ? "them" : "it", names.size() > 1 ? "their" : "its");
+  else if (!interval_note.empty())
+    errors = "  No standard error: " + interval_note + "; the intervals above are those with the held values taken as known.\n";
+  if (!edge.empty())
+    edge = fmt::format("  {} ended at the edge of the range searched (1/8 to 8 times the guess): the data may not determine {} (G keeps\n"
+                       "  falling beyond it, as when a parameter's operation approaches another candidate's), or the guess is far off.\n",
+                       edge, at_edge.size() > 1 ? "them" : "it");
   if (!moved())
     return fmt::format("Nonlinear parameters held at their initial guess{}: {} (no value scanned from 1/8 to 8 times it, nor Nelder-Mead,\n"
                        "gave a smaller G; {} fits).\n",
-                       names.size() > 1 ? "es" : "", values_text, fits);
+                       names.size() > 1 ? "es" : "", values_text, fits) +
+           errors + edge;
   return fmt::format("Nonlinear parameters by variable projection (the linear ones solved for each trial value; {} fits):\n"
-                     "  {}, from the guess{} {}: G = {:.6g} there, {:.6g} at the guess{}. The fit above holds them at these values.\n",
-                     fits, values_text, names.size() > 1 ? "es" : "", guesses_text, G_best, G_guess, names.size() > 1 ? "es" : "");
+                     "  {}, from the guess{} {}: G = {:.6g} there, {:.6g} at the guess{}. The fit above holds {} at {}.\n",
+                     fits, values_text, names.size() > 1 ? "es" : "", guesses_text, G_best, G_guess, names.size() > 1 ? "es" : "",
+                     names.size() > 1 ? "them" : "it", names.size() > 1 ? "these values" : "this value") +
+         errors + edge;
+}
+
+NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector<SampledRecord>& records, const FitOptions& options,
+                                       const std::vector<double>& held, FitSummary& summary) {
+  NonlinearIntervals out;
+  std::vector<std::size_t> nonlinear;
+  for (std::size_t k = 0; k < model.parameters.size(); ++k)
+    if (model.parameters[k].nonlinear) nonlinear.push_back(k);
+  const std::size_t m = nonlinear.size();
+  out.standard_errors.assign(m, std::numeric_limits<double>::quiet_NaN());
+  if (!summary.is_solution_usable()) {
+    out.note = "the fit is rank deficient";
+    return out;
+  }
+  double G = 0;
+  std::size_t rows = 0, rank = 0;
+  for (const auto& g : summary.groups) G += g.summary.G, rows += g.summary.n, rank += g.summary.rank;
+  if (rows <= rank + m) {
+    out.note = "too few rows for the nonlinear parameters' curvature";
+    return out;
+  }
+  // The fit with the nonlinear parameters moved by `shift` (per nonlinear parameter).
+  const auto fitted_at = [&](const std::vector<double>& shift) -> std::optional<FitSummary> {
+    std::vector<double> values = held;
+    for (std::size_t k = 0; k < m; ++k) values[nonlinear[k]] += shift[k];
+    auto r = fit(fix_nonlinear(model, values), records, options);
+    if (auto* s = std::get_if<FitSummary>(&r); s && s->is_solution_usable()) return std::move(*s);
+    return std::nullopt;
+  };
+  const auto total_G = [](const FitSummary& s) {
+    double total = 0;
+    for (const auto& g : s.groups) total += g.summary.G;
+    return total;
+  };
+  std::vector<double> h(m);
+  for (std::size_t k = 0; k < m; ++k) h[k] = 1e-3 * std::max(std::abs(held[nonlinear[k]]), 1e-6);
+  // The profile's Hessian, and the linear solution's derivatives, per group and column.
+  Eigen::MatrixXd hessian(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+  std::vector<std::vector<std::vector<double>>> moved(m);  // [k][group][column]: da/dk
+  for (std::size_t k = 0; k < m; ++k) {
+    std::vector<double> up(m, 0.0), down(m, 0.0);
+    up[k] = h[k], down[k] = -h[k];
+    const auto plus = fitted_at(up), minus = fitted_at(down);
+    if (!plus || !minus || plus->groups.size() != summary.groups.size() || minus->groups.size() != summary.groups.size()) {
+      out.note = "a fit next to the held values failed";
+      return out;
+    }
+    hessian(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) = (total_G(*plus) - 2 * G + total_G(*minus)) / (h[k] * h[k]);
+    moved[k].resize(summary.groups.size());
+    for (std::size_t g = 0; g < summary.groups.size(); ++g) {
+      const auto& a = plus->groups[g].summary.parameters;
+      const auto& b = minus->groups[g].summary.parameters;
+      if (a.size() != summary.groups[g].summary.parameters.size() || b.size() != a.size()) {
+        out.note = "a fit next to the held values has other columns";
+        return out;
+      }
+      for (std::size_t c = 0; c < a.size(); ++c) moved[k][g].push_back((a[c].value - b[c].value) / (2 * h[k]));
+    }
+    for (std::size_t j = 0; j < k; ++j) {
+      double corners = 0;
+      for (const double sj : {1.0, -1.0})
+        for (const double sk : {1.0, -1.0}) {
+          std::vector<double> shift(m, 0.0);
+          shift[j] = sj * h[j], shift[k] = sk * h[k];
+          const auto at = fitted_at(shift);
+          if (!at) {
+            out.note = "a fit next to the held values failed";
+            return out;
+          }
+          corners += sj * sk * total_G(*at);
+        }
+      const double cross = corners / (4 * h[j] * h[k]);
+      hessian(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(k)) = cross;
+      hessian(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = cross;
+    }
+  }
+  Eigen::LLT<Eigen::MatrixXd> llt(hessian);
+  if (llt.info() != Eigen::Success || !hessian.allFinite()) {
+    out.note = "G is not curved upward at the held values (the data do not determine them)";
+    return out;
+  }
+  const double s2 = G / static_cast<double>(rows - rank - m);
+  const Eigen::MatrixXd cov = 2 * s2 * llt.solve(Eigen::MatrixXd::Identity(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m)));
+  for (std::size_t k = 0; k < m; ++k) out.standard_errors[k] = std::sqrt(cov(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)));
+  // The linear parameters: their conditional covariance plus D Cov(k) D^T, D the columns' da/dk.
+  for (std::size_t g = 0; g < summary.groups.size(); ++g) {
+    LeastSquaresSummary& ls = summary.groups[g].summary;
+    const auto p = static_cast<Eigen::Index>(ls.parameters.size());
+    Eigen::MatrixXd d(p, static_cast<Eigen::Index>(m));
+    for (Eigen::Index c = 0; c < p; ++c)
+      for (std::size_t k = 0; k < m; ++k) d(c, static_cast<Eigen::Index>(k)) = moved[k][g][static_cast<std::size_t>(c)];
+    const Eigen::MatrixXd added = d * cov * d.transpose();
+    if (ls.covariance.rows() == p && ls.covariance.cols() == p) ls.covariance += added;
+    for (Eigen::Index c = 0; c < p; ++c) {
+      ParameterEstimate& e = ls.parameters[static_cast<std::size_t>(c)];
+      if (!(e.standard_error > 0)) continue;
+      const double t = (e.ci_high - e.value) / e.standard_error;  // the interval's quantile, kept
+      e.standard_error = std::sqrt(e.standard_error * e.standard_error + added(c, c));
+      e.ci_low = e.value - t * e.standard_error;
+      e.ci_high = e.value + t * e.standard_error;
+    }
+  }
+  return out;
 }
 
 }  // namespace sidc

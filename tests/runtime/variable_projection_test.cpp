@@ -82,6 +82,76 @@ TEST(VariableProjection, FindsTheNonlinearParameterFromGuessesOffByFactors) {
   EXPECT_NEAR(there.values[0], there.guesses[0], 1e-6 * there.guesses[0]);
 }
 
+// sin(L*theta) beside k*theta: as L goes to 0, mgl*sin(L*theta) + k*theta fits theta and theta^3
+// ever better with ever larger mgl and k, so G keeps falling; the search stops at its range's edge
+// and says the data may not determine L, instead of wandering off to L = 1e-4.
+TEST(VariableProjection, NamesAParameterTheDataDoNotDetermine) {
+  const CompileResult truth = compiled(0.8);
+  const std::vector<SampledRecord> records{pendulum_record(*truth.normalized, 0.02, 1)};  // noise: the exact L would give G = 0
+  std::string text = kPendulum;
+  text.replace(text.find("GUESS"), 5, "2");
+  text.replace(text.find(" = u"), 4, " + k*theta = u");
+  text.replace(text.find("param J, c, mgl,"), 16, "param J, c, mgl, k,");
+  const CompileResult r = compile(std::make_shared<const SourceFile>("degenerate.sid", text), {});
+  ASSERT_TRUE(r.ok()) << r.diagnostics.render_all();
+  const VariableProjectionSummary v = projected(r, records);
+  EXPECT_EQ(v.at_edge, std::vector<std::string>{"L"}) << v.report();
+  EXPECT_NEAR(v.values[0], 0.25, 1e-9);
+  EXPECT_NE(v.report().find("the data may not determine it"), std::string::npos);
+}
+
+// A static nonlinear regression, y = a*exp(-k*x) + b with white noise: the equation error is the
+// output error, so variable projection gives the least-squares estimate, and the intervals of
+// nonlinear_intervals (k's from the curvature of G, a's and b's widened by k's uncertainty) must
+// hold the truth at about their nominal rate over seeds, and k's standard error match the scatter
+// of its estimates.
+TEST(VariableProjection, StaticRegressionIntervalsHoldTheTruth) {
+  const CompileResult r = compile(std::make_shared<const SourceFile>("decay.sid", "input x\noutput y\nparam a, b, k = 0.2\ny = a*exp(-k*x) + b\n"), {});
+  ASSERT_TRUE(r.ok()) << r.diagnostics.render_all();
+  const std::vector<double> truth = {3.0, 0.5, 0.7};
+  const int seeds = 100;
+  std::vector<int> held(3, 0);
+  std::vector<double> k_estimates, k_errors;
+  for (int seed = 0; seed < seeds; ++seed) {
+    std::mt19937 engine(static_cast<unsigned>(seed));
+    std::normal_distribution<double> noise(0.0, 0.05);
+    SampledRecord record;
+    record.path = "decay.csv";
+    record.step = 1;
+    std::vector<double> x, y;
+    for (int i = 0; i < 60; ++i) {
+      record.time.push_back(i);
+      x.push_back(0.1 * i);
+      y.push_back(truth[0] * std::exp(-truth[2] * x.back()) + truth[1] + noise(engine));
+    }
+    record.signals["x"] = std::move(x);
+    record.signals["y"] = std::move(y);
+    const std::vector<SampledRecord> records{std::move(record)};
+    const VariableProjectionSummary v = projected(r, records);
+    auto fitted = fit(fix_nonlinear(*r.integrated, v.held), records, {});
+    ASSERT_TRUE(std::holds_alternative<FitSummary>(fitted));
+    FitSummary& summary = std::get<FitSummary>(fitted);
+    const NonlinearIntervals intervals = nonlinear_intervals(*r.integrated, records, {}, v.held, summary);
+    ASSERT_EQ(intervals.standard_errors.size(), 1u);
+    ASSERT_TRUE(std::isfinite(intervals.standard_errors[0])) << intervals.note;
+    for (const auto& e : summary.groups[0].summary.parameters) {
+      const std::size_t q = e.name == "a" ? 0 : 1;
+      held[q] += e.ci_low <= truth[q] && truth[q] <= e.ci_high;
+    }
+    held[2] += std::abs(v.values[0] - truth[2]) <= 1.96 * intervals.standard_errors[0];
+    k_estimates.push_back(v.values[0]);
+    k_errors.push_back(intervals.standard_errors[0]);
+  }
+  for (std::size_t q = 0; q < 3; ++q) EXPECT_GE(held[q], 86) << "parameter " << q;  // 95% nominal; Wald intervals of a curved model hold a little less
+  double mean = 0, squares = 0;
+  for (double k : k_estimates) mean += k / seeds;
+  for (double k : k_estimates) squares += (k - mean) * (k - mean);
+  std::sort(k_errors.begin(), k_errors.end());
+  const double ratio = std::sqrt(squares / (seeds - 1)) / k_errors[seeds / 2];
+  EXPECT_GT(ratio, 0.8);
+  EXPECT_LT(ratio, 1.25);
+}
+
 TEST(VariableProjection, ThenRefinementEstimatesEveryParameter) {
   const CompileResult start = compiled(1.2);
   const ir::Model& model = *start.normalized;

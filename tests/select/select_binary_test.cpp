@@ -259,6 +259,20 @@ TEST(SelectBinary, DriftAbsorberIsFlaggedAndSetAside) {
   EXPECT_NE(last_select.err.find("warning: `a`"), std::string::npos) << last_select.err;
 }
 
+TEST(SelectBinary, NonlinearParameterIsHeldAtItsProjectedValue) {
+  const fs::path clean = simulated_record("truth_nonlinear_pendulum.sid", "--param J=1 --param c=0.3 --param g=9.81 --param L=0.8",
+                                          "\"y=0.5,y'=0\"", 30);
+  const auto j = select_json("candidates_nonlinear.sid", noisy_record(2e-3, clean), "");
+  ASSERT_FALSE(j.is_discarded());
+  EXPECT_EQ(chosen(j), (std::set<std::string>{"J", "c", "g"}));
+  const std::string said = "nonlinear parameters held for every subset at the values of least equation error of all the candidates";
+  const auto at = last_select.out.find(said);
+  ASSERT_NE(at, std::string::npos) << last_select.out;
+  const auto value = last_select.out.find("L = ", at);
+  ASSERT_NE(value, std::string::npos);
+  EXPECT_NEAR(std::stod(last_select.out.substr(value + 4)), 0.8, 0.01) << last_select.out;
+}
+
 TEST(SelectBinary, TrueOperationsAreNotTakenForDriftAbsorbers) {
   // Integrated once, the Duffing record's even powers (y'^2, y^2) have a mean and integrate to
   // near-ramps, but before integration they are far from a line: nothing is flagged.

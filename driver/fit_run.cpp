@@ -298,12 +298,23 @@ std::optional<Diagnostic> output_overwrites_input(const FitRun& run, const std::
   return std::nullopt;
 }
 
+FitFiles fit_files_of(const FitRun& run) {
+  return {run.compiled,
+          run.model_path,
+          run.summary,
+          run.options,
+          run.loaded.records,
+          run.validation,
+          run.residuals,
+          run.form_choice ? &*run.form_choice : nullptr,
+          run.refinement ? &*run.refinement : nullptr,
+          run.instrumental_variables ? &*run.instrumental_variables : nullptr,
+          run.local ? &*run.local : nullptr,
+          run.nonlinear && run.nonlinear->projection ? &*run.nonlinear->projection : nullptr};
+}
+
 std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory) {
-  return write_fit_files(directory, {run.compiled, run.model_path, run.summary, run.options, run.loaded.records, run.validation, run.residuals,
-                                     run.form_choice ? &*run.form_choice : nullptr, run.refinement ? &*run.refinement : nullptr,
-                                     run.instrumental_variables ? &*run.instrumental_variables : nullptr,
-                                     run.local ? &*run.local : nullptr,
-                                     run.nonlinear && run.nonlinear->projection ? &*run.nonlinear->projection : nullptr});
+  return write_fit_files(directory, fit_files_of(run));
 }
 
 bool write_pictures(const FitRun& run, const PictureRequest& request, std::vector<std::string>& written, std::string& error) {

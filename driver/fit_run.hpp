@@ -24,6 +24,7 @@
 
 #include "driver/failure.hpp"
 #include "driver/record_settings.hpp"
+#include "report/fit_files.hpp"
 #include "report/fit_pictures.hpp"
 #include "runtime/refine/refine.hpp"
 #include "runtime/simulate/form_choice.hpp"
@@ -109,6 +110,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out);
 // An output that is one of the run's inputs (the model, its source, a record): the error to give
 // before anything is written (after prepare_fit, the inputs are known).
 std::optional<Diagnostic> output_overwrites_input(const FitRun& run, const std::vector<std::string>& outputs);
+// What fit.json and the other files are made of (report/fit_files.hpp), for every face the same.
+FitFiles fit_files_of(const FitRun& run);
 // fit.json, residuals.csv, validation.csv and local.csv into `directory` (report/fit_files.hpp): the paths written.
 std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory);
 // The pictures and the HTML report (report/fit_pictures.hpp); false with `error` (rendered).

@@ -53,10 +53,7 @@ std::variant<std::vector<std::string>, std::string> save_session(const FitSessio
 }
 
 nlohmann::ordered_json fit_json_document(const FitSession& session) {
-  const driver::FitRun& s = session.run;
-  return fit_document({s.compiled, s.model_path, s.summary, s.options, s.loaded.records, s.validation, s.residuals,
-                       s.form_choice ? &*s.form_choice : nullptr, s.refinement ? &*s.refinement : nullptr,
-                       s.instrumental_variables ? &*s.instrumental_variables : nullptr});
+  return fit_document(driver::fit_files_of(session.run));
 }
 
 std::variant<ResidualColumns, Diagnostic> residual_columns(const FitSession& session) {

@@ -107,7 +107,8 @@ class Model:
 
 class FitResult:
     """One fit. `estimates`, `standard_errors`, `ci95`: dicts by parameter name (integration
-    constants too, as fit.json lists them); `hac_ci95`: the Newey-West intervals where computed; `covariance`: a numpy matrix in the order of
+    constants too, as fit.json lists them); `hac_ci95`: the Newey-West intervals where computed;
+    `nonlinear`: the parameters that enter nonlinearly (held values, standard errors, refined); `covariance`: a numpy matrix in the order of
     `estimates`; `G`: the sum of squared equation errors over the groups (eq. 2-1.7);
     `statistics`: one dict per equation group (fit.json's); `validation`: fit.json's (None with
     no_validate); `residuals`: dict of numpy arrays (residuals.csv's columns); `report()`: what
@@ -179,6 +180,27 @@ class FitResult:
         where the fit computed them (dense derivative- and integrated-form fits: docs/accuracy.md,
         "Intervals under autocorrelated rows"); the residual analysis says which intervals to trust."""
         return {p["name"]: tuple(_number(x) for x in p["hac_ci95"]) for p in self._parameters() if "hac_ci95" in p}
+
+    @property
+    def nonlinear(self):
+        """The parameters that enter nonlinearly (`param L = 1.2` inside `sin(L*theta)`), by name:
+        dicts with `guess`, `held` (the value the equation-error fit held it at, found by variable
+        projection), `standard_error` and `ci95` (held -/+ 1.96 standard errors; None without a
+        standard error) and, after a refinement that did not fail, `refined`; {} when there are none.
+        `estimates` and the others list only the parameters the linear fit estimated."""
+        block = self.document.get("nonlinear_parameters") or {}
+        out = {}
+        for p in block.get("parameters", []):
+            se = _number(p["standard_error"]) if p.get("standard_error") is not None else None
+            held = _number(p["held"])
+            out[p["name"]] = {"guess": _number(p["guess"]), "held": held, "standard_error": se,
+                              "ci95": (held - 1.96 * se, held + 1.96 * se) if se is not None else None}
+        refinement = self.document.get("refinement") or {}
+        if refinement.get("status") not in (None, "failed"):
+            for p in refinement.get("parameters", []):
+                if p["name"] in out:
+                    out[p["name"]]["refined"] = _number(p["refined"])
+        return out
 
     @property
     def covariance(self):

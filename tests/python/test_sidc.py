@@ -112,6 +112,23 @@ class FitAgreesWithCli(Workspace):
         # G is the sum of the squared residuals (eq. 2-1.7, unweighted here).
         self.assertAlmostEqual(float(np.sum(residuals["residual"] ** 2)), result.G, delta=1e-12 * max(1.0, result.G))
 
+    def test_nonlinear_parameters(self):
+        # y = a*exp(-k*x) + b: k held at the value of least G, with a standard error, as fit.json has it.
+        path = os.path.join(self.dir, "decay.sid")
+        with open(path, "w") as f:
+            f.write("model decay\ninput x\noutput y\nparam a, b, k = 0.2\ny = a*exp(-k*x) + b\n")
+        x = np.arange(60) * 0.1
+        y = 3 * np.exp(-0.7 * x) + 0.5 + 0.05 * np.random.default_rng(7).standard_normal(60)
+        result = sidc.compile(path).fit({"x": x, "y": y})
+        self.assertEqual(sorted(result.estimates), ["a", "b"])
+        k = result.nonlinear["k"]
+        self.assertEqual(k["guess"], 0.2)
+        self.assertEqual(k["held"], result.document["nonlinear_parameters"]["parameters"][0]["held"])
+        self.assertLess(abs(k["held"] - 0.7), 4 * k["standard_error"])
+        self.assertAlmostEqual(k["ci95"][1] - k["held"], 1.96 * k["standard_error"])
+        self.assertNotIn("refined", k)
+        self.assertEqual(sidc.compile(self.model_path).fit(read_record(self.csv)).nonlinear, {})
+
     def test_settings_are_the_clis_options(self):
         cli = self.cli_fit("--every", "2", "--to", "0.7", "--no-validate", "--derivative", "savgol(5, 2)")
         model = sidc.compile(self.model_path)

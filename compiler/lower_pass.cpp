@@ -77,7 +77,7 @@ bool has_parameter(const Sum& s, std::string* name = nullptr, const std::vector<
   return false;
 }
 
-// Any parameter anywhere in the sum, nested ones too (guards and sign(): where a branch switches).
+// Any parameter anywhere in the sum, nested ones too.
 bool has_nested_parameter(const Sum& s, std::string* name) {
   bool found = false;
   ir::walk_factors(s, [&](const Factor& f, const Term&) {
@@ -296,8 +296,8 @@ struct Lowerer {
     for (const auto& c : g.conditions) {
       Sum lhs = lower(c.lhs), rhs = lower(c.rhs);
       std::string name;
-      if (has_nested_parameter(lhs, &name) || has_nested_parameter(rhs, &name)) {
-        report(diag::parameter_in_switch(span(c), name, "inside a guard `[...]`"));
+      if (has_parameter(lhs, &name, &decl.model.parameters) || has_parameter(rhs, &name, &decl.model.parameters)) {
+        report(diag::nonlinear_parameter(span(c), name, "it stands inside a guard `[...]`"));
         return {};
       }
       ir::Relation r = c.op == "<" ? ir::Relation::less
@@ -401,10 +401,6 @@ struct Lowerer {
     }
     if (has_parameter(argument, &parameter_name, &decl.model.parameters)) {
       report(diag::nonlinear_parameter(where, parameter_name, fmt::format("it stands inside `{}(...)`", name)));
-      return {};
-    }
-    if (name == "sign" && has_nested_parameter(argument, &parameter_name)) {
-      report(diag::parameter_in_switch(where, parameter_name, "inside `sign(...)`"));
       return {};
     }
     return function_of(name, std::move(argument), where);

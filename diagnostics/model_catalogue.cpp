@@ -235,12 +235,6 @@ Diagnostic nonlinear_parameter(const Span& where, std::string_view name, std::st
                            name));
 }
 
-Diagnostic parameter_in_switch(const Span& where, std::string_view name, std::string_view place) {
-  return error("parameter-in-switch", where, fmt::format("parameter `{}` stands {}, where a branch switches", name, place),
-               "the time of a switch would move with the parameter, which neither the linear fit nor the refinement can "
-               "follow yet: write the threshold as a number or a constant (`const y0 = 0.2`), or move the parameter out of the condition");
-}
-
 Diagnostic no_known_term(const Span& where) {
   return error("no-known-term", where,
                "every term of this equation holds a parameter, so the least-squares solution is all zeros",

@@ -97,8 +97,6 @@ Diagnostic wrong_arity(const Span& where, std::string_view function, std::string
 Diagnostic derivative_of_parameter(const Span& where, std::string_view name);
 Diagnostic derivative_of_constant(const Span& where, std::string_view name);
 Diagnostic nonlinear_parameter(const Span& where, std::string_view name, std::string_view how);
-// A parameter inside a guard or sign(): a switching function that would depend on it.
-Diagnostic parameter_in_switch(const Span& where, std::string_view name, std::string_view place);
 Diagnostic no_known_term(const Span& where);
 Diagnostic no_parameter(const Span& where);
 Diagnostic declared_twice(const Span& where, std::string_view name, const Span& first);

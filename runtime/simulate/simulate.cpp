@@ -130,6 +130,19 @@ class System {
     }
     if (sensitivities_ && full)
       if (auto d = nonlinear_partials(model, *full, o)) return d;
+    // A threshold that is a nonlinear parameter (`[y > y0]`): the switch time moves with it too.
+    switching_nonlinear_.assign(form.switching_functions.size(), {});
+    if (sensitivities_ && full)
+      for (std::size_t i = 0; i < full->switching_functions.size(); ++i)
+        for (std::size_t q = 0; q < model.parameters.size(); ++q) {
+          if (!model.parameters[q].nonlinear) continue;
+          auto d = partial_derivative_by_parameter(full->switching_functions[i], static_cast<int>(q));
+          if (!d) return diag::simulate_estimated_derivative(model.parameters[q].span, model.parameters[q].name);
+          if (d->empty()) continue;
+          auto c = compile_point_sum(substitute_parameters(*d, o.parameters), layout_, compile_options_);
+          if (auto* e = std::get_if<Diagnostic>(&c)) return *e;
+          switching_nonlinear_[i].emplace_back(q, std::get<PointSum>(std::move(c)));
+        }
     for (const auto& g : form.switching_functions) {
       auto c = compile_point_sum(g, layout_, compile_options_);
       if (auto* d = std::get_if<Diagnostic>(&c)) return *d;
@@ -310,9 +323,10 @@ class System {
 
   // The sensitivities' jump where switching function g changes sign between (before, x_before)
   // and (after, x_after): the state is continuous but the right-hand side jumps from f- to f+,
-  // and the switch time moves with every parameter, d tau/dq = -(g_x S)/(g_x f- + g_t), so
-  // S+ = S- + (f+ - f-) (g_x S-) / (g_x f- + g_t) (Hiskens and Pai, IEEE TCAS-I 47(2), 2000,
-  // eq. 12). g_t, where g reads t or an input, by a central difference in time at fixed state.
+  // and the switch time moves with every parameter, d tau/dq = -(g_x S + g_q)/(g_x f- + g_t), so
+  // S+ = S- + (f+ - f-) (g_x S- + g_q) / (g_x f- + g_t) (Hiskens and Pai, IEEE TCAS-I 47(2), 2000,
+  // eq. 12); g_q is 0 but for a nonlinear parameter in g (`[y > y0]`). g_t, where g reads t or an
+  // input, by a central difference in time at fixed state.
   void jump_sensitivities(double before, std::vector<double>& x_before, double after, std::vector<double>& x_after) {
     if (!sensitivities_ || switching_.empty()) return;
     const std::size_t n = state_size(), columns = sensitivity_columns();
@@ -341,9 +355,12 @@ class System {
       const double down = switching_[i].evaluate({slots_, before - delta, options_->t0_for_tau, {}});
       speed += (up - down) / (2 * delta);
       if (!(std::abs(speed) > 0) || !std::isfinite(speed)) continue;  // grazing: no transversal crossing to move
+      std::vector<double> gq(columns, 0.0);
+      fill(before, x_before.data());
+      for (auto& [q, partial] : switching_nonlinear_[i]) gq[q] = partial.evaluate({slots_, before, options_->t0_for_tau, {}});
       for (std::size_t q = 0; q < columns; ++q) {
         double* column = x_after.data() + n + q * n;
-        double moved = 0;
+        double moved = gq[q];
         for (std::size_t m = 0; m < n; ++m) moved += gx[m] * column[m];
         moved /= speed;
         for (std::size_t m = 0; m < n; ++m) column[m] += (f_after[m] - f_before[m]) * moved;
@@ -502,6 +519,7 @@ class System {
   std::vector<double> frozen_values_;  // freeze()'s switching values, kept to spare an allocation per step
   bool frozen_ = false;
   std::vector<std::vector<PointSum>> switching_partial_;  // [function][state component], with sensitivities
+  std::vector<std::vector<std::pair<std::size_t, PointSum>>> switching_nonlinear_;  // [function]: (parameter, d g / d parameter)
   std::vector<Source> sources_;
   std::vector<double> slots_;
   std::optional<double> initial_det_;

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "ir/fix_parameters.hpp"
+#include "ir/traversal.hpp"
 
 namespace sidc {
 namespace {
@@ -116,6 +117,26 @@ void nelder_mead(Objective& f, std::vector<double>& best, double& best_value, co
     if (fx[k] < best_value) best = x[k], best_value = fx[k];
 }
 
+// The first nonlinear parameter that stands in a guard or in sign() (a threshold, `[y > y0]`): G
+// changes in steps as the threshold passes samples, so it has no curvature to take there.
+const ir::Parameter* threshold(const ir::Model& model) {
+  const ir::Parameter* found = nullptr;
+  const auto visit = [&](const ir::Factor& f, const ir::Term&) {
+    if (f.kind == ir::FactorKind::guard || (f.kind == ir::FactorKind::function && f.name == "sign"))
+      ir::for_each_nested_sum(f, [&](const ir::Sum& inner) {
+        ir::for_each_factor(inner, [&](const ir::Factor& g) {
+          if (g.kind == ir::FactorKind::parameter && !found) found = &model.parameters[static_cast<std::size_t>(g.order)];
+        });
+      });
+    return found ? ir::Step::stop : ir::Step::into;
+  };
+  for (const auto& e : model.equations) {
+    for (const auto& t : e.terms) ir::walk_factors(t.operation, visit);
+    ir::walk_factors(e.known, visit);
+  }
+  return found;
+}
+
 }  // namespace
 
 std::variant<VariableProjectionSummary, Diagnostic> variable_projection(const ir::Model& model, const std::vector<SampledRecord>& records,
@@ -191,7 +212,7 @@ std::string VariableProjectionSummary::report() const {
                          "  like them, assume independent rows.\n",
                          names.size() > 1 ? "s:" : " of", errors, names.size() > 1 ? "them" : "it", names.size() > 1 ? "their" : "its");
   else if (!interval_note.empty())
-    errors = "  No standard error: " + interval_note + "; the intervals above are those with the held values taken as known.\n";
+    errors = "  No standard error: " + interval_note + ";\n  the intervals above are those with the held values taken as known.\n";
   if (!edge.empty())
     edge = fmt::format("  {} ended at the edge of the range searched (1/8 to 8 times the guess): the data may not determine {} (G keeps\n"
                        "  falling beyond it, as when a parameter's operation approaches another candidate's), or the guess is far off.\n",
@@ -218,6 +239,10 @@ NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector
   out.standard_errors.assign(m, std::numeric_limits<double>::quiet_NaN());
   if (!summary.is_solution_usable()) {
     out.note = "the fit is rank deficient";
+    return out;
+  }
+  if (const ir::Parameter* p = threshold(model)) {
+    out.note = fmt::format("`{}` is a threshold (in a guard or sign()), where G changes in steps as it passes the samples", p->name);
     return out;
   }
   double G = 0;

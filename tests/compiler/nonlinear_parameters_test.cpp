@@ -51,16 +51,18 @@ TEST(NonlinearParameters, ABesideParameterWithAGuessIsNonlinear) {
 }
 
 TEST(NonlinearParameters, ErrorsNameTheParameterAndWhatToWrite) {
-  const auto unguessed = testing::compile_text("input x\noutput y\nparam a, k\na*y' + exp(-k*t)*y = x\n");
+  const auto no_guess = testing::compile_text("input x\noutput y\nparam a, k\na*y' + exp(-k*t)*y = x\n");
+  ASSERT_FALSE(no_guess.ok());
+  EXPECT_NE(no_guess.diagnostics.render_all().find("give `k` an initial guess (`param k = 1.5`)"), std::string::npos)
+      << no_guess.diagnostics.render_all();
+  // A threshold: with a guess it stands in a guard or sign() (nonlinear); without one it is an error.
+  const auto guard = testing::compile_text("input x\noutput y\nparam a, y0 = 0.1, v = 1\na*y' + [y > y0]*y + sign(v*y') = x\n");
+  ASSERT_TRUE(guard.ok()) << guard.diagnostics.render_all();
+  EXPECT_TRUE(guard.normalized->parameters[1].nonlinear && guard.normalized->parameters[2].nonlinear);
+  const auto unguessed = testing::compile_text("input x\noutput y\nparam a, b, y0\na*y' + b*[y > y0]*y = x\n");
   ASSERT_FALSE(unguessed.ok());
-  EXPECT_NE(unguessed.diagnostics.render_all().find("give `k` an initial guess (`param k = 1.5`)"), std::string::npos)
-      << unguessed.diagnostics.render_all();
-  const auto guard = testing::compile_text("input x\noutput y\nparam a, y0 = 0.1\na*y' + [y > y0]*y = x\n");
-  ASSERT_FALSE(guard.ok());
-  EXPECT_EQ(guard.diagnostics.items.front().code, "parameter-in-switch");
-  const auto sign = testing::compile_text("input x\noutput y\nparam a, c, v = 1\na*y' + c*sign(v*y') = x\n");
-  ASSERT_FALSE(sign.ok());
-  EXPECT_EQ(sign.diagnostics.items.front().code, "parameter-in-switch");
+  EXPECT_EQ(unguessed.diagnostics.items.front().code, "nonlinear-parameter");
+  EXPECT_NE(unguessed.diagnostics.render_all().find("inside a guard"), std::string::npos);
   const auto signal = testing::compile_text("input x\noutput y\nparam a, L = y\na*y' + sin(L*y) = x\n");
   ASSERT_FALSE(signal.ok());
   EXPECT_NE(signal.diagnostics.render_all().find("a parameter's initial guess must be a number"), std::string::npos);

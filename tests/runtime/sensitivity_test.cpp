@@ -141,5 +141,21 @@ TEST(Sensitivity, JumpAtEachSwitchOfAGuard) {
   EXPECT_LT(largest_sensitivity_error(m, o), 1e-5);
 }
 
+// A threshold that is a nonlinear parameter (`param y0 = 0.1` in `[y > y0]`, a preload that acts
+// beyond a gap; `sign(y' - v0)`): the switch time moves with it, d tau/d y0 = -(g_x S + g_y0)/(g_x f + g_t),
+// and the sensitivities jump by that too.
+TEST(Sensitivity, JumpAtASwitchWhoseThresholdIsAParameter) {
+  const ir::Model m = normalized(
+      "input x = 2*cos(t)\noutput y\nparam a, b, d, e, f, y0 = 0.1, v0 = 0.05\n"
+      "a*y'' + d*y' + b*y + e*[y > y0] + f*sign(y' - v0) = x\n");
+  ASSERT_TRUE(m.parameters[5].nonlinear && m.parameters[6].nonlinear);
+  ASSERT_EQ(form_of(m).switching_functions.size(), 2u);
+  SimulateOptions o;
+  o.parameters = {1.0, 2.0, 0.3, 0.4, 0.05, 0.2, 0.1};
+  o.initial["y"] = {0.5, 0.3};
+  o.time = grid(0, 15, 0.02);
+  EXPECT_LT(largest_sensitivity_error(m, o), 1e-5);
+}
+
 }  // namespace
 }  // namespace sidc

@@ -739,6 +739,22 @@ std::optional<ir::PlotFunction> lower_plot(Lowerer& l, const ast::PlotStatement&
   out.signal = argument;
   out.order = order;
   out.truth = std::move(truth);
+  // A parameter inside a function of the plot has a value only when the equations made it
+  // nonlinear (and the fit holds it at one).
+  std::string unfitted;
+  ir::walk_factors(*fitted, [&](const Factor& f, const Term&) {
+    ir::for_each_nested_sum(f, [&](const Sum& inner) {
+      ir::for_each_factor(inner, [&](const Factor& g) {
+        if (g.kind == FactorKind::parameter && !l.decl.model.parameters[static_cast<std::size_t>(g.order)].nonlinear && unfitted.empty())
+          unfitted = g.name;
+      });
+    });
+    return ir::Step::over;
+  });
+  if (!unfitted.empty()) {
+    l.diagnostics.add(diag::plot_parameter_not_fitted(where, plot, unfitted));
+    return std::nullopt;
+  }
   auto split = split_by_parameter(*fitted, l.decl.model, l.diagnostics);
   if (!split) return std::nullopt;
   for (auto& [parameter, terms] : split->operations) {

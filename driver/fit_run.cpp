@@ -220,7 +220,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   // Output-error refinement (issue 15): from that estimate, the parameters whose solved equations
   // reproduce the fitted records best. A failure keeps the estimate it started from and says so.
   auto& refinement = run.refinement;
-  // With nonlinear parameters it refines the model that has them, from their guesses.
+  // With nonlinear parameters it refines the model that has them, from the values the
+  // equation-error fit held them at.
   const ir::Model& refined_model = run.nonlinear ? run.nonlinear->normalized : compiled.normalized;
   const std::variant<ExplicitForm, Diagnostic>& refined_form = run.nonlinear ? run.nonlinear->explicit_form : *compiled.explicit_form;
   if (refine_asked && summary.is_solution_usable()) {
@@ -259,12 +260,12 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     for (const auto& r : extra) checked.push_back(&r);
     // The refined values are the refined model's (nonlinear parameters included).
     const bool refined = refinement && refinement->improved();
-    run.validation = validate_fit(refined ? refined_model : compiled.normalized, refined ? refined_form : *compiled.explicit_form, summary, checked, records.size(), o.evaluation, a.validate_samples,
-                                  a.initial_state,
-                                  refinement && refinement->improved() ? &refinement->values
-                                  : iv && iv->is_solution_usable()      ? &fitted_estimate
-                                                                        : nullptr,
-                                  refinement && refinement->improved() ? "refined by the output error" : "of instrumental variables",
+    run.validation = validate_fit(refined ? refined_model : compiled.normalized, refined ? refined_form : *compiled.explicit_form, summary,
+                                  checked, records.size(), o.evaluation, a.validate_samples, a.initial_state,
+                                  refined                          ? &refinement->values
+                                  : iv && iv->is_solution_usable() ? &fitted_estimate
+                                                                   : nullptr,
+                                  refined ? "refined by the output error" : "of instrumental variables",
                                   out.progress ? [&out](const std::string& record, std::size_t done, std::size_t total) {
                                     out.progress("validation: solving the fitted equations against " + record + " (samples)", done, total);
                                   } : std::function<void(const std::string&, std::size_t, std::size_t)>());

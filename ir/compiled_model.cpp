@@ -286,6 +286,8 @@ std::vector<ir::ParameterTerm> read_operations(const json& j, const ParameterInd
   for (const auto& o : j) {
     const auto index = indices.find(o.at("parameter").get<std::string>());
     if (index == indices.end()) throw std::runtime_error("an operation names an undeclared parameter");
+    // A nonlinear parameter stands inside operations, never as one's parameter (normalize_pass).
+    if (r.nonlinear.count(index->first)) throw std::runtime_error("the nonlinear parameter `" + index->first + "` multiplies an operation");
     terms.push_back({index->second, r.sum(o.at("operation"))});
   }
   return terms;

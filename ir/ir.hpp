@@ -37,7 +37,7 @@ struct Condition {
 
 // The kinds of factor, in the order they are written within a term.
 enum class FactorKind {
-  parameter,      // a_k: only before normalize_pass splits parameters off
+  parameter,      // a_k before normalize_pass splits the linear ones off; a nonlinear one (Parameter::nonlinear) stays
   test_function,  // phi_j and its derivatives (`order`): the weak form's test function on subdomain j
   signal,         // y, y', y'': `name`, derivative `order`
   initial_value,  // y(0), y'(t0): `name`, `order`, `at` (nullopt = t0); a constant read from the record

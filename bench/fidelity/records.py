@@ -106,8 +106,9 @@ def model_text(system, equations, kind, declare_params=True):
     if system.inputs:
         lines.append("input " + ", ".join(f"{n} {system.holds[n]}" if n in system.holds else n for n in system.inputs))
     lines.append("output " + ", ".join(system.outputs))
-    if declare_params:
-        lines.append("param " + ", ".join(system.truth))
+    names = list(system.truth) if declare_params else list(system.library_params)
+    if names:  # a nonlinear parameter needs its guess, so it needs a declaration
+        lines.append("param " + ", ".join(f"{n} = {system.guesses[n]}" if n in system.guesses else n for n in names))
     lines.append('data "record.csv"')
     lines.append(SETTINGS_MARKER)
     lines.append(equations)

@@ -156,13 +156,19 @@ def run_case(sidc, work, config, system, level, seed, timeout):
         fit = json.load(open(fit_path))
         est = {p["name"]: p["estimate"] for g in fit.get("groups", []) for p in g.get("parameters", [])}
         ci = {p["name"]: p.get("ci95") for g in fit.get("groups", []) for p in g.get("parameters", [])}
-        row["equation_error_max_rel_error"] = max_relative_error(est, system.truth)[0]
+        held_values = {p["name"]: p["held"] for p in (fit.get("nonlinear_parameters") or {}).get("parameters", [])}
+        row["equation_error_max_rel_error"] = max_relative_error({**est, **held_values}, system.truth)[0]
         iv = fit.get("instrumental_variables")  # `set estimator = iv`: its estimate is the one judged
         if iv:
             row["iv_termination"], row["iv_iterations"] = iv.get("termination"), iv.get("iterations")
             if iv.get("groups"):
                 est = {p["name"]: p["estimate"] for g in iv["groups"] for p in g["parameters"]}
                 ci = {p["name"]: p.get("ci95") for g in iv["groups"] for p in g["parameters"]}
+        # Nonlinear parameters (`param L = 1.5`): the values the fit held them at, with their intervals.
+        for p in (fit.get("nonlinear_parameters") or {}).get("parameters", []):
+            est[p["name"]] = p["held"]
+            se = p.get("standard_error")
+            ci[p["name"]] = None if se is None else [p["held"] - 1.96 * se, p["held"] + 1.96 * se]
         refinement = fit.get("refinement")  # `set refine = simulation`: the refined values are the fit's answer
         row["refined"] = refinement.get("status") if refinement else None
         if refinement and refinement.get("status") != "failed":
@@ -195,7 +201,7 @@ def run_case(sidc, work, config, system, level, seed, timeout):
     if fit is not None:
         initial = [f"{k}={v!r}" for k, v in truth["initial_state"].items()]
         rc, err, s2 = run([sidc, "simulate", "truth_model.sid", "--params", "fit/fit.json", "--data", "truth.csv",
-                           "--substeps", "10", "-o", "truth_sim.csv", "--initial"] + initial, d, timeout)
+                           "--substeps", "10", "-o", "truth_sim.csv", "--initial", ",".join(initial)], d, timeout)
         row["seconds"] += s2
         reference = read_csv(os.path.join(d, "truth.csv"))
         percents = []

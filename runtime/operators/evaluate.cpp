@@ -290,7 +290,8 @@ std::variant<std::vector<double>, Diagnostic> Evaluator::factor(const ir::Factor
     case FactorKind::parameter:
     case FactorKind::test_function: break;
   }
-  // normalize_pass takes every parameter out of the operations, and the weak form's test functions
+  // normalize_pass takes every linear parameter out of the operations, the fit holds the nonlinear
+  // ones at values before it evaluates (ir/fix_parameters.hpp), and the weak form's test functions
   // are integrated by runtime/solve/weak_design.cpp before evaluation; one here is a bug (exit code 3).
   throw std::logic_error(fmt::format("the factor `{}` reached the evaluator", print(f)));
 }

@@ -522,6 +522,10 @@ TEST(CompiledModelFile, ReaderRefusesValuesItWouldMisread) {
       {"power 0", [&](json& j) { j[factor]["power"] = 0; }},
       {"a factor of a parameter not marked nonlinear", [&](json& j) { j[factor] = {{"kind", "parameter"}, {"name", "a1"}, {"power", 1}}; }},
       {"a nonlinear parameter without a guess", [](json& j) { j["parameters"][0]["nonlinear"] = true; }},
+      {"a nonlinear parameter multiplying an operation", [](json& j) {
+         j["parameters"][0]["nonlinear"] = true;
+         j["parameters"][0]["guess"] = {{"num", 1}, {"den", 1}};
+       }},
       {"a factor of an undeclared signal", [&](json& j) { j[factor]["name"] = "w"; }},
       {"unknown setting", [](json& j) { j["settings"]["as_written"]["derivativ"] = "savgol(7, 3)"; }},
       {"invalid setting value", [](json& j) { j["settings"]["as_written"]["every"] = "many"; }},

@@ -68,6 +68,18 @@ TEST(NonlinearParameters, ErrorsNameTheParameterAndWhatToWrite) {
   EXPECT_NE(signal.diagnostics.render_all().find("a parameter's initial guess must be a number"), std::string::npos);
 }
 
+// A plot may use a nonlinear parameter the equations hold at a value, not one only the plot uses.
+TEST(NonlinearParameters, PlotsUseOnlyParametersTheEquationsFit) {
+  const std::string model = "input x\noutput y\nparam m, c, k, L = 1.2\nm*y'' + c*y' + k*sin(L*y) = x\n";
+  const auto fitted = testing::compile_text(model + "plot spring(y) = k*sin(L*y)\n");
+  ASSERT_TRUE(fitted.ok()) << fitted.diagnostics.render_all();
+  ASSERT_EQ(fitted.normalized->plots.size(), 1u);
+  EXPECT_EQ(print(fitted.normalized->plots[0].terms[0].operation), "sin(L*y)");
+  const auto unfitted = testing::compile_text("input x\noutput y\nparam m, c, k, P = 2\nm*y'' + c*y' + k*y = x\nplot spring(y) = k*sin(P*y)\n");
+  ASSERT_FALSE(unfitted.ok());
+  EXPECT_NE(unfitted.diagnostics.render_all().find("`P`"), std::string::npos) << unfitted.diagnostics.render_all();
+}
+
 TEST(NonlinearParameters, PrintedModelCarriesTheGuesses) {
   const auto r = testing::compile_text("input x\noutput y\nparam m, c[1..2] = 0.5, L = 1.2\nm*y'' + c[1]*y' + c[2]*sin(L*y) = x\n");
   const ir::Model m = ok(r);

@@ -8,7 +8,7 @@
 #        bash scripts/test.sh --release       # the Release build and its tests only
 #        bash scripts/test.sh --sanitize      # the sanitizer pass only
 #        bash scripts/test.sh --sanitize --build-only   # build build-asan/, run nothing (scripts/fuzz.sh)
-#   SIDC_FUZZ_SECONDS (default 20) sets how long each fuzz target runs in the sanitizer pass.
+#   SIDC_FUZZ_SECONDS (default 15) sets how long each fuzz target runs in the sanitizer pass.
 #
 # The sanitizer pass, and why it is a subset. CI is a fresh clone on a 2-core machine and the
 # whole command should stay under 15 minutes; the Release build and suite take about 8 of them
@@ -64,7 +64,7 @@ echo "test.sh: configuring build-asan (Clang, ASan + UBSan, fuzz targets)"
 cmake -S "$repo_root" -B "$repo_root/build-asan" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
   "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -gline-tables-only" -DSIDC_FUZZ=ON -DSIDC_WERROR="$werror" \
   "-DSIDC_UNOPTIMIZED_LAYERS=runtime;report;driver;cli" \
-  -DSIDC_FUZZ_SECONDS="${SIDC_FUZZ_SECONDS:-20}"
+  -DSIDC_FUZZ_SECONDS="${SIDC_FUZZ_SECONDS:-15}"
 # The unit-test executables of label `input`: sidc_input_tests(TARGET) in tests/*/CMakeLists.txt.
 input_targets=$(grep -ho 'sidc_input_tests([a-z_0-9]*' "$repo_root"/tests/*/CMakeLists.txt | sed -E 's/sidc_input_tests\(//' | sort -u)
 echo "test.sh: building build-asan with $(nproc) jobs"

@@ -14,7 +14,6 @@
 
 #include "cli/exit_codes.hpp"
 #include "cli/fitted_values.hpp"
-#include "ir/fix_parameters.hpp"
 #include "cli/output_check.hpp"
 #include "compiler/explicit_form_pass.hpp"
 #include "compiler/pipeline.hpp"
@@ -58,9 +57,9 @@ int run_export(const ExportArguments& a) {
     all.push_back(values[i].value_or(0.0));
   }
   if (!missing.empty()) return fail(render(cli_diag::cannot_export("fit.json gives no finite estimate of " + missing)), exit_code::user_error);
-  // Nonlinear parameters (`sin(L*theta)`) are exported as the numbers fitted, like constants.
-  const ir::Model model = fix_nonlinear(as_compiled, all);
-  const std::vector<double> known = linear_part(as_compiled, all);
+  // Nonlinear parameters (`sin(L*theta)`) are declared with the others and named where they stand.
+  const ir::Model& model = as_compiled;
+  const std::vector<double>& known = all;
 
   const std::map<std::string, ExportLanguage> languages{{"c", ExportLanguage::c}, {"python", ExportLanguage::python}, {"latex", ExportLanguage::latex}};
   const ExportLanguage language = languages.at(a.language);

@@ -53,7 +53,6 @@ std::optional<std::string> record_only(const ir::Factor& f) {
     case FactorKind::derivative: return std::string("der() (a derivative estimated from the record)");
     case FactorKind::integral: return std::string("int() (an integral over the record)");
     case FactorKind::test_function: return std::string("a weak-form test function");
-    case FactorKind::parameter: return std::string("a parameter inside an operation");
     default: return std::nullopt;
   }
 }
@@ -133,6 +132,7 @@ class CodePrinter {
         }
         return python() ? fmt::format("(1.0 if {} else 0.0)", test) : fmt::format("({} ? 1.0 : 0.0)", test);
       }
+      case FactorKind::parameter: return identifier(f.name, language_);  // a nonlinear one (`sin(L*y)`), declared with the others
       default: return "0.0";  // record_only() took the others
     }
   }

@@ -120,6 +120,16 @@ def main():
              "--t1", "20", "--step", "0.01", "--substeps", "4", "-o", "coupled.csv"], work)
         check(sidc, work, "coupled.sid", [("y", 0, 0.3), ("y", 1, -0.2), ("z", 0, 0.1), ("z", 1, 0.7)], 1.0, 0.01)
     with tempfile.TemporaryDirectory() as work:
+        # A nonlinear parameter (`param L = 2` inside `sin(L*theta)`): declared by name with the value
+        # the fit held it at, and named where it stands.
+        golden = os.path.join(root, "tests", "golden", "fit")
+        shutil.copy(os.path.join(golden, "nonlinear_refined.sid"), os.path.join(work, "pendulum.sid"))
+        shutil.copy(os.path.join(golden, "nonlinear_refined.files", "record.csv"), work)
+        check(sidc, work, "pendulum.sid", [("theta", 0, 0.4), ("theta", 1, -0.3)], 2.0, 0.02)
+        held = json.load(open(os.path.join(work, "fit", "fit.json")))["nonlinear_parameters"]["parameters"][0]["held"]
+        code = open(os.path.join(work, "rhs.c")).read()
+        assert f"static const double L = {held!r};" in code and "sin(L*state[0])" in code, "the C export does not name L"
+    with tempfile.TemporaryDirectory() as work:
         refusals(sidc, root, work)
     return 0
 

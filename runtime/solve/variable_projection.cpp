@@ -159,14 +159,15 @@ std::variant<VariableProjectionSummary, Diagnostic> variable_projection(const ir
   // The scan, one parameter at a time from the best point so far: a guess may be off by a factor,
   // and G is often multimodal in a frequency or a rate (sin(L*theta), exp(-k*t)).
   for (std::size_t k = 0; k < best.size(); ++k) {
+    const double guess = out.guesses[k];
     std::vector<double> scales;
     for (int e = -6; e <= 6; ++e)
       if (e != 0) scales.push_back(std::pow(2.0, e / 2.0));
     for (const double s : scales)
       for (const double sign : {1.0, -1.0}) {
-        if (best[k] != 0 && sign < 0) continue;  // a nonzero guess gives the sign
+        if (guess != 0 && sign < 0) continue;  // a nonzero guess gives the sign
         auto v = best;
-        v[k] = best[k] != 0 ? out.guesses[k] * s : sign * s;
+        v[k] = guess != 0 ? guess * s : sign * s;
         const double g = f.value(v);
         if (g < best_value) best_value = g, best = v;
       }

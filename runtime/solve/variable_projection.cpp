@@ -209,8 +209,8 @@ std::string VariableProjectionSummary::report() const {
   for (std::size_t k = 0; k < standard_errors.size() && k < names.size(); ++k)
     if (std::isfinite(standard_errors[k])) errors += fmt::format("{}{} {:.3g}", errors.empty() ? "" : ", ", names[k], standard_errors[k]);
   if (!errors.empty())
-    errors = fmt::format("  Standard error{} {} (from the curvature of G over {}); the intervals above include {} uncertainty and,\n"
-                         "  like them, assume independent rows.\n",
+    errors = fmt::format("  Standard error{} {} (from the curvature of G over {}); the classical intervals above include {}\n"
+                         "  uncertainty (the Newey-West ones, where printed, do not) and, like them, assume independent rows.\n",
                          names.size() > 1 ? "s:" : " of", errors, names.size() > 1 ? "them" : "it", names.size() > 1 ? "their" : "its");
   else if (!interval_note.empty())
     errors = "  No standard error: " + interval_note + ";\n  the intervals above are those with the held values taken as known.\n";

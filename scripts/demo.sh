@@ -2,8 +2,8 @@
 # The main job on the bundled examples: sets up and builds (scripts/setup.sh), then compiles the
 # thesis section 4-1 model and fits it to the thesis Appendix A record (examples/thesis-4-1/),
 # then does the same for the section 4-2 process (its input smooth, then held between samples), the
-# Silverbox record, a noisy Duffing record and a drifting stiffness fitted locally along its record
-# (thesis chapter V), each with its pictures.
+# Silverbox record, a noisy Duffing record, a drifting stiffness fitted locally along its record
+# (thesis chapter V) and a pendulum with a parameter inside sin(), each with its pictures.
 # Relies on: scripts/setup.sh producing build/cli/sidc. Guarantees: says which step it runs,
 # works from any current directory, stops at the first failing step.
 set -euo pipefail
@@ -23,7 +23,7 @@ run_example() {  # folder, model, step number, [pictures folder: the example's f
   cd "$repo_root/examples/$folder"
   # The compiled model is named: a folder with two examples holds two (plain `sidc fit` refuses).
   local compiled=${model%.sid}.sidc.json
-  echo "demo.sh: step $step of 6: sidc compile $model && sidc fit $compiled --plots $out (in examples/$folder)"
+  echo "demo.sh: step $step of 7: sidc compile $model && sidc fit $compiled --plots $out (in examples/$folder)"
   "$sidc" compile "$model"
   rm -rf "$out"
   "$sidc" fit "$compiled" --plots "$out" --report "$out/report.html"
@@ -34,4 +34,5 @@ run_example thesis-4-2 process_held.sid 3 thesis-4-2-held
 run_example silverbox derivative_form.sid 4
 run_example noisy-duffing duffing.sid 5
 run_example time-varying drift.sid 6
-echo "demo.sh: pictures and one-page reports in $pictures/{thesis-4-1,thesis-4-2,thesis-4-2-held,silverbox,noisy-duffing,time-varying}/"
+run_example pendulum-length pendulum.sid 7
+echo "demo.sh: pictures and one-page reports in $pictures/{thesis-4-1,thesis-4-2,thesis-4-2-held,silverbox,noisy-duffing,time-varying,pendulum-length}/"

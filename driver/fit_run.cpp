@@ -49,23 +49,12 @@ std::string choose_the_form(FitRun& run) {
   return run.form_choice->report();
 }
 
-// The compiled models with the nonlinear parameters at `run.nonlinear->held`, from the models that
-// have them.
-void hold_nonlinear_parameters(FitRun& run) {
-  const NonlinearParameters& n = *run.nonlinear;
-  CompiledModel& c = run.compiled;
-  c.integrated = fix_nonlinear(n.integrated, n.held);
-  if (auto* form = std::get_if<ExplicitForm>(&n.explicit_form)) c.explicit_form = fix_nonlinear(*form, n.normalized, n.held);
-  else c.explicit_form = n.explicit_form;
-  c.normalized = fix_nonlinear(n.normalized, n.held);
-}
-
 // The values the equation-error fit holds the nonlinear parameters at: those of least G from
 // their guesses (variable_projection.hpp), in the form it fits (the weak form when the data
 // choose it: the first candidate).
 std::optional<Failure> project_nonlinear_parameters(FitRun& run, const FitOutput& out) {
   NonlinearParameters& n = *run.nonlinear;
-  const ir::Model searched = run.compiled.integrated.form_from_data ? rewritten_in_form(n.normalized, "weak") : n.integrated;
+  const ir::Model searched = n.compiled.integrated.form_from_data ? rewritten_in_form(n.compiled.normalized, "weak") : n.compiled.integrated;
   auto projection = variable_projection(searched, run.loaded.records, run.options);
   if (auto* d = std::get_if<Diagnostic>(&projection)) return failure(*d);
   n.projection = std::get<VariableProjectionSummary>(std::move(projection));
@@ -73,21 +62,20 @@ std::optional<Failure> project_nonlinear_parameters(FitRun& run, const FitOutput
     out.warning(fmt::format("sidc fit: warning: nonlinear parameter `{}` ended at the edge of the range searched from its guess "
                             "(1/8 to 8 times it): the data may not determine it, or the guess is far off",
                             name));
-  if (n.projection->moved() && std::isfinite(n.projection->G_best)) {
-    for (std::size_t k = 0; k < n.held.size(); ++k)
-      if (std::isfinite(n.projection->held[k])) n.held[k] = n.projection->held[k];
-    hold_nonlinear_parameters(run);
-  }
+  // The projection's values are the guesses where it found nothing better.
+  n.held = n.projection->held;
+  run.compiled = fix_nonlinear(n.compiled, n.held);
   return std::nullopt;
 }
 
 }  // namespace
 
 std::vector<double> NonlinearParameters::with_held(const std::vector<double>& linear) const {
-  std::vector<double> out(normalized.parameters.size());
+  const auto& parameters = compiled.normalized.parameters;
+  std::vector<double> out(parameters.size());
   std::size_t next = 0;
   for (std::size_t k = 0; k < out.size(); ++k)
-    out[k] = normalized.parameters[k].nonlinear ? held[k] : next < linear.size() ? linear[next++] : 0.0;
+    out[k] = parameters[k].nonlinear ? held[k] : next < linear.size() ? linear[next++] : 0.0;
   return out;
 }
 
@@ -112,11 +100,8 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
   }
   // Nonlinear parameters: held at their guesses until run_fit searches for better values.
   if (has_nonlinear_parameters(c.normalized) && c.explicit_form) {
-    NonlinearParameters n{c.normalized, c.integrated, *c.explicit_form, {}, nonlinear_guesses(c.normalized), std::nullopt};
-    for (const auto& p : c.normalized.parameters)
-      if (p.nonlinear) n.names.push_back(p.name);
-    run->nonlinear = std::move(n);
-    hold_nonlinear_parameters(*run);
+    run->nonlinear = NonlinearParameters{c, nonlinear_guesses(c.normalized), std::nullopt};
+    c = fix_nonlinear(run->nonlinear->compiled, run->nonlinear->held);
   }
   const FitSettings& f = run->settings;
   if (f.stride != 1 && !f.local && !f.forget && !local_width_setting(c.integrated.settings))
@@ -169,7 +154,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     NonlinearParameters& n = *run.nonlinear;
     const std::string form = run.form_choice ? run.form_choice->scores[run.form_choice->chosen].name : form_from_data ? "weak" : "";
     const NonlinearIntervals intervals =
-        nonlinear_intervals(form.empty() ? n.integrated : rewritten_in_form(n.normalized, form), records, o, n.held, run.summary);
+        nonlinear_intervals(form.empty() ? n.compiled.integrated : rewritten_in_form(n.compiled.normalized, form), records, o, n.held, run.summary);
     n.projection->standard_errors = intervals.standard_errors;
     n.projection->interval_note = intervals.note;
   }
@@ -190,7 +175,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     const VariableProjectionSummary& v = *run.nonlinear->projection;
     const bool intervals = std::any_of(v.standard_errors.begin(), v.standard_errors.end(), [](double e) { return std::isfinite(e); });
     std::string next;
-    const char* them = run.nonlinear->names.size() > 1 ? "them" : "it";
+    const char* them = v.names.size() > 1 ? "them" : "it";
     if (refine_asked && summary.is_solution_usable()) next = fmt::format("The refinement below estimates {} with the others.\n", them);
     else if (!is_static(model))
       next = fmt::format("--refine (or `set refine = simulation`) estimates {} with the others by the output error, free of the equation\n"
@@ -198,7 +183,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     out.report("\n" + v.report() + next);
     if (!intervals && !(refine_asked && summary.is_solution_usable()))
       out.warning(fmt::format("sidc fit: warning: {} {} held by the equation-error fit without an interval ({}){}",
-                              fmt::join(run.nonlinear->names, ", "), run.nonlinear->names.size() > 1 ? "are" : "is", v.interval_note,
+                              fmt::join(v.names, ", "), v.names.size() > 1 ? "are" : "is", v.interval_note,
                               is_static(model) ? "" : fmt::format(": add --refine to estimate {} with an interval", them)));
   }
 
@@ -222,8 +207,8 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   auto& refinement = run.refinement;
   // With nonlinear parameters it refines the model that has them, from the values the
   // equation-error fit held them at.
-  const ir::Model& refined_model = run.nonlinear ? run.nonlinear->normalized : compiled.normalized;
-  const std::variant<ExplicitForm, Diagnostic>& refined_form = run.nonlinear ? run.nonlinear->explicit_form : *compiled.explicit_form;
+  const ir::Model& refined_model = run.nonlinear ? run.nonlinear->compiled.normalized : compiled.normalized;
+  const std::variant<ExplicitForm, Diagnostic>& refined_form = run.nonlinear ? *run.nonlinear->compiled.explicit_form : *compiled.explicit_form;
   if (refine_asked && summary.is_solution_usable()) {
     if (auto* d = std::get_if<Diagnostic>(&refined_form)) {
       refinement.emplace();

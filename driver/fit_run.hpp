@@ -65,13 +65,12 @@ struct FitOutput {
 };
 
 // A model's nonlinear parameters (`param L = 1.2` inside `sin(L*theta)`, ir/fix_parameters.hpp):
-// the models as compiled, with them, and the values the equation-error fit holds them at (found by
-// variable projection from the guesses), for the refinement that estimates them with the others.
+// the compiled model as it was, with them, and the values the equation-error fit holds them at
+// (found by variable projection from the guesses), for the refinement that estimates them with the
+// others.
 struct NonlinearParameters {
-  ir::Model normalized, integrated;
-  std::variant<ExplicitForm, Diagnostic> explicit_form;
-  std::vector<std::string> names;
-  std::vector<double> held;  // per parameter of `normalized`: the value held, NaN for a linear one
+  CompiledModel compiled;    // its explicit form set (prepare_fit holds only such models)
+  std::vector<double> held;  // per parameter of `compiled.normalized`: the value held, NaN for a linear one
   std::optional<VariableProjectionSummary> projection;
   // The equation-error estimate (by `compiled.normalized`'s parameters) with the held values put
   // back: one value per parameter of `normalized`, the refinement's start.

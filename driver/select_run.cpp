@@ -1,7 +1,5 @@
 #include "driver/select_run.hpp"
 
-#include <cmath>
-
 #include <algorithm>
 #include <map>
 
@@ -113,20 +111,12 @@ std::optional<Failure> run_select(SelectRun& run, const FitOutput& out) {
     auto projection = variable_projection(model, records, o.fit);
     if (auto* d = std::get_if<Diagnostic>(&projection)) return failure(*d);
     const VariableProjectionSummary& v = std::get<VariableProjectionSummary>(projection);
-    std::vector<double> held = nonlinear_guesses(compiled.normalized);
-    if (std::isfinite(v.G_best))
-      for (std::size_t k = 0; k < held.size() && k < v.held.size(); ++k)
-        if (std::isfinite(v.held[k])) held[k] = v.held[k];
-    std::string values;
-    for (std::size_t k = 0; k < held.size(); ++k)
-      if (compiled.normalized.parameters[k].nonlinear)
-        values += fmt::format("{}{} = {:.7g}", values.empty() ? "" : ", ", compiled.normalized.parameters[k].name, held[k]);
+    std::string values;  // the projection's values are the guesses where it found nothing better
+    for (std::size_t k = 0; k < v.names.size(); ++k) values += fmt::format("{}{} = {:.7g}", k ? ", " : "", v.names[k], v.values[k]);
     run.form_note += fmt::format("nonlinear parameters held for every subset at the values of least equation error of all the candidates "
                                  "(variable projection from the guesses, {} fits): {}\n",
                                  v.fits, values);
-    if (auto* form = std::get_if<ExplicitForm>(&*compiled.explicit_form)) compiled.explicit_form = fix_nonlinear(*form, compiled.normalized, held);
-    compiled.integrated = fix_nonlinear(compiled.integrated, held);
-    compiled.normalized = fix_nonlinear(compiled.normalized, held);
+    compiled = fix_nonlinear(CompiledModel(compiled), v.held);
   }
   auto result = select_operations(model, records, o);
   if (auto* d = std::get_if<Diagnostic>(&result); d && run.weak_by_default && d->code == "weak-form-too-short") {

@@ -124,6 +124,18 @@ ExplicitForm fix_nonlinear(const ExplicitForm& form, const ir::Model& model, con
   return substitute(form, nonlinear_values(model, values), &renumber);
 }
 
+CompiledModel fix_nonlinear(const CompiledModel& compiled, const std::vector<double>& values) {
+  CompiledModel out;
+  out.source = compiled.source;
+  out.normalized = fix_nonlinear(compiled.normalized, values);
+  out.integrated = fix_nonlinear(compiled.integrated, values);
+  if (compiled.explicit_form) {
+    if (const auto* form = std::get_if<ExplicitForm>(&*compiled.explicit_form)) out.explicit_form = fix_nonlinear(*form, compiled.normalized, values);
+    else out.explicit_form = compiled.explicit_form;
+  }
+  return out;
+}
+
 std::vector<double> linear_part(const ir::Model& model, const std::vector<double>& full) {
   std::vector<double> out;
   for (std::size_t k = 0; k < model.parameters.size() && k < full.size(); ++k)

@@ -15,6 +15,7 @@
 
 #include <vector>
 
+#include "ir/compiled_model.hpp"
 #include "ir/explicit_form.hpp"
 #include "ir/ir.hpp"
 
@@ -37,6 +38,8 @@ ExplicitForm substitute_nonlinear(const ExplicitForm& form, const ir::Model& mod
 // others renumbered in order), and the same for its explicit form.
 ir::Model fix_nonlinear(const ir::Model& model, const std::vector<double>& values);
 ExplicitForm fix_nonlinear(const ExplicitForm& form, const ir::Model& model, const std::vector<double>& values);
+// All three models of a compiled model (normalized, integrated, explicit form) held the same way.
+CompiledModel fix_nonlinear(const CompiledModel& compiled, const std::vector<double>& values);
 
 // `full` (one value per parameter of `model`) without its nonlinear parameters' entries: the
 // values in fix_nonlinear(model, ...)'s parameter order.

@@ -15,6 +15,13 @@ namespace {
 
 constexpr double kInfinite = std::numeric_limits<double>::infinity();
 
+// eq. 2-1.7 summed over the equation groups.
+double total_G(const FitSummary& s) {
+  double total = 0;
+  for (const auto& g : s.groups) total += g.summary.G;
+  return total;
+}
+
 // Total G of the linear fit with the nonlinear parameters at `values` (infinite when it cannot be
 // fitted or is rank deficient: such a point is never the best).
 class Objective {
@@ -31,8 +38,7 @@ class Objective {
     if (auto* d = std::get_if<Diagnostic>(&result)) return *d;
     const FitSummary& s = std::get<FitSummary>(result);
     if (!s.is_solution_usable()) return kInfinite;
-    double total = 0;
-    for (const auto& g : s.groups) total += g.summary.G;
+    const double total = total_G(s);
     return std::isfinite(total) ? total : kInfinite;
   }
   // Infinite once the budget of fits is spent: the search then ends with the best point so far.
@@ -246,9 +252,9 @@ NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector
     out.note = fmt::format("`{}` is a threshold (in a guard or sign()), where G changes in steps as it passes the samples", p->name);
     return out;
   }
-  double G = 0;
+  const double G = total_G(summary);
   std::size_t rows = 0, rank = 0;
-  for (const auto& g : summary.groups) G += g.summary.G, rows += g.summary.n, rank += g.summary.rank;
+  for (const auto& g : summary.groups) rows += g.summary.n, rank += g.summary.rank;
   if (rows <= rank + m) {
     out.note = "too few rows for the nonlinear parameters' curvature";
     return out;
@@ -260,11 +266,6 @@ NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector
     auto r = fit(fix_nonlinear(model, values), records, options);
     if (auto* s = std::get_if<FitSummary>(&r); s && s->is_solution_usable()) return std::move(*s);
     return std::nullopt;
-  };
-  const auto total_G = [](const FitSummary& s) {
-    double total = 0;
-    for (const auto& g : s.groups) total += g.summary.G;
-    return total;
   };
   std::vector<double> h(m);
   for (std::size_t k = 0; k < m; ++k) h[k] = 1e-3 * std::max(std::abs(held[nonlinear[k]]), 1e-6);

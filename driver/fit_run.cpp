@@ -114,6 +114,12 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
   auto options = fit_options(c.integrated, run->settings.records);
   if (auto* d = std::get_if<Diagnostic>(&options)) return failure(*d, true);
   run->options = std::get<FitOptions>(options);
+  // The projection compares G at trial values; whitened rows would change their metric with every
+  // trial (a profile of generalised least squares needs the covariance's determinant as well).
+  if (run->nonlinear) {
+    run->options.weak_covariance = false;
+    run->options.weak_covariance_off = "the model's nonlinear parameters are searched on unweighted rows";
+  }
   if (out.progress)
     run->options.progress = [progress = out.progress](std::size_t done, std::size_t total) {
       progress("fitting: rows folded into the triangular factor", done, total);

@@ -29,7 +29,7 @@ std::optional<int> whole_number(const std::string& text) {
 const std::vector<std::string>& setting_keys() {
   static const std::vector<std::string> keys{"integrate", "form", "constants", "derivative", "second_derivative", "edges",
                                              "integration", "smooth_before_integration", "from", "to", "every", "step", "weights", "refine",
-                                             "estimator", "time_unit", "local"};
+                                             "estimator", "time_unit", "local", "weak_weighting"};
   return keys;
 }
 
@@ -88,6 +88,10 @@ SettingCheck check_setting(const std::string& key, const std::string& value) {
     if (value != "least_squares" && value != "iv")
       r.expected = "`least_squares` (equation error, thesis section 2-1; the default) or `iv` (refined instrumental variables: "
                    "instruments from the fitted equations solved without noise)";
+  } else if (key == "weak_weighting") {
+    if (value != "covariance" && value != "none")
+      r.expected = "`covariance` (the weak form's rows weighted by the covariance their noise gives them: generalised least "
+                   "squares, the default) or `none` (least squares of rows taken as independent)";
   } else if (key == "time_unit") {
     ir::UnitParseError error;
     if (!ir::parse_unit(value, &error))
@@ -141,6 +145,7 @@ EvaluationSettings evaluation_settings(const ir::Settings& settings) {
   if (auto v = get("every")) e.every = std::stoi(*v);
   if (auto v = get("step")) e.step = Number::parse(*v)->value();
   if (auto v = get("weights")) e.weights = v->front() == '"' ? v->substr(1, v->size() - 2) : *v;
+  if (auto v = get("weak_weighting")) e.weak_covariance = *v == "covariance";
   return e;
 }
 

@@ -48,6 +48,7 @@ struct EvaluationSettings {
   int every = 1;                           // decimation
   std::optional<double> step;              // sampling step when the record has no time column
   std::optional<std::string> weights;      // a record column weighting each row's residual (eq. 2-1.6)
+  bool weak_covariance = true;             // `weak_weighting = covariance`: the weak rows whitened by their noise
 };
 
 // `form` (`derivative`, `integrated`, `weak`; check_setting has accepted it) as the integration

@@ -188,6 +188,9 @@ nlohmann::ordered_json fit_json(const FitSummary& s, const CompiledModel& c, con
                                       {"digits_lost_estimate", ls.digits_lost_estimate}}},
                       {"termination", to_string(ls.termination)}, {"message", ls.message}, {"arithmetic", ls.arithmetic},
                       {"dependent_operations", dependent}, {"drift", drift}});
+    if (!g.subdomains.empty())
+      groups.back()["weak_weighting"] = {{"covariance", g.weak_weighting.applied}, {"solves", g.weak_weighting.iterations},
+                                         {"residual_variance", g.weak_weighting.residual_variance}, {"note", g.weak_weighting.note}};
     if (g.hac.computed)
       groups.back()["hac"] = {{"bandwidth", g.hac.bandwidth}, {"lag1_autocorrelation", g.hac.lag1_autocorrelation}, {"band99", g.hac.band},
                               {"prewhitening_clamped", g.hac.prewhitening_clamped}};

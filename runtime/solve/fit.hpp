@@ -31,6 +31,7 @@
 #include "runtime/solve/drift_check.hpp"
 #include "runtime/solve/hac_covariance.hpp"
 #include "runtime/solve/least_squares.hpp"
+#include "runtime/solve/weak_covariance.hpp"
 
 namespace sidc {
 
@@ -55,6 +56,10 @@ struct FitOptions {
   // Optional: a streamed group's rows folded so far and in all (per equation and record), after
   // each stretch, from the calling thread (a progress line; nothing computed depends on it).
   std::function<void(std::size_t done, std::size_t total)> progress;
+  // The weak form's rows weighted by the covariance their noise gives them (weak_covariance.hpp;
+  // `set weak_weighting = covariance`, the default); false: least squares of independent rows.
+  bool weak_covariance = true;
+  std::string weak_covariance_off = "set weak_weighting = none";  // why not, for the report, when false
   bool is_valid(std::string* why) const;
 };
 
@@ -97,6 +102,7 @@ struct GroupFit {
   std::string streamed;
   // Weak-form groups (weak_design.hpp): per record, its subdomains and how their width was chosen.
   std::vector<std::string> subdomains;
+  WeakWeighting weak_weighting;  // weak-form groups: how their rows were weighted
   // CPU seconds (all threads) spent evaluating operations and folding rows (streamed fits), and
   // wall seconds of the final p x p solve, for the bench.
   double evaluate_seconds = 0, fold_seconds = 0, solve_seconds = 0;

@@ -11,7 +11,15 @@ ModelTotals model_totals(const std::string& name, const ir::Model& model, const 
   ModelTotals t;
   t.name = name;
   t.usable = summary.is_solution_usable();
-  for (const auto& g : summary.groups) t.n += g.summary.n, t.p += g.summary.p, t.G += g.summary.G;
+  for (const auto& g : summary.groups) {
+    t.n += g.summary.n, t.p += g.summary.p;
+    // Weak rows weighted by their noise covariance (weak_covariance.hpp) are whitened by each model's
+    // own metric; their unweighted residuals are what two models' G can compare.
+    if (g.weak_weighting.applied)
+      for (double r : g.summary.residuals) t.G += r * r;
+    else
+      t.G += g.summary.G;
+  }
   for (const auto& equation : model.equations) t.known += print(equation.known) + "; ";
   return t;
 }

@@ -23,6 +23,7 @@ FitOptions fit_options(const EvaluationSettings& e) {
   o.evaluation = evaluation_options(e);
   o.from = e.from;
   o.to = e.to;
+  o.weak_covariance = e.weak_covariance;
   return o;
 }
 

@@ -156,7 +156,11 @@ std::variant<VariableProjectionSummary, Diagnostic> variable_projection(const ir
     out.names.push_back(p.name);
     out.guesses.push_back(p.guess ? p.guess->value() : 0.0);
   }
-  Objective f(model, records, options, nonlinear, projection.max_fits);
+  // G of unweighted rows at every trial: whitened rows (weak_covariance.hpp) would change their
+  // metric with the trial values.
+  FitOptions unweighted = options;
+  unweighted.weak_covariance = false;
+  Objective f(model, records, unweighted, nonlinear, projection.max_fits);
   auto at_guess = f(out.guesses);
   if (auto* d = std::get_if<Diagnostic>(&at_guess)) return *d;
   out.G_guess = std::get<double>(at_guess);
@@ -260,10 +264,12 @@ NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector
     return out;
   }
   // The fit with the nonlinear parameters moved by `shift` (per nonlinear parameter).
+  FitOptions unweighted = options;  // as the search's fits
+  unweighted.weak_covariance = false;
   const auto fitted_at = [&](const std::vector<double>& shift) -> std::optional<FitSummary> {
     std::vector<double> values = held;
     for (std::size_t k = 0; k < m; ++k) values[nonlinear[k]] += shift[k];
-    auto r = fit(fix_nonlinear(model, values), records, options);
+    auto r = fit(fix_nonlinear(model, values), records, unweighted);
     if (auto* s = std::get_if<FitSummary>(&r); s && s->is_solution_usable()) return std::move(*s);
     return std::nullopt;
   };

@@ -16,19 +16,6 @@
 namespace sidc {
 namespace {
 
-// The order of a term's test function and the term without it (weak_pass puts exactly one,
-// to the power 1, on every term; the compiled-model reader checks files for the same).
-std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
-  ir::Term rest = t;
-  int order = 0;
-  auto it = std::find_if(rest.factors.begin(), rest.factors.end(), [](const auto& f) { return f.first.kind == ir::FactorKind::test_function; });
-  if (it != rest.factors.end()) {
-    order = it->first.order;
-    rest.factors.erase(it);
-  }
-  return {order, rest};
-}
-
 int highest_test_function_order(const DesignBuilder& design) {
   int k = 0;
   for (const ir::Sum* s : design.sums())
@@ -53,6 +40,17 @@ std::set<std::string> outputs_used(const ir::Model& model, const DesignBuilder& 
 ir::Sum signal_sum(const std::string& name) { return ir::factor(ir::Factor{ir::FactorKind::signal, name, 0, {}, {}, {}, {}}); }
 
 }  // namespace
+
+std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
+  ir::Term rest = t;
+  int order = 0;
+  auto it = std::find_if(rest.factors.begin(), rest.factors.end(), [](const auto& f) { return f.first.kind == ir::FactorKind::test_function; });
+  if (it != rest.factors.end()) {
+    order = it->first.order;
+    rest.factors.erase(it);
+  }
+  return {order, rest};
+}
 
 // sum_i w[i] * x[i] over a test function's support (thousands of samples) in four running sums,
 // added pairwise at the end: one sum would wait on each addition in turn (a latency of four

@@ -30,6 +30,10 @@ namespace sidc {
 // rows would not be commensurable: samples against subdomains).
 std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations);
 
+// The order k of a weak term's test function phi_j^(k) and the term without it (weak_pass puts
+// exactly one, to the power 1, on every term; the compiled-model reader checks files for the same).
+std::pair<int, ir::Term> split_test_function(const ir::Term& t);
+
 // sum_i w[i] * x[i] over a support (w.size() values from x): each row's integral, summed in a fixed
 // order, so that the result is the same on every run and thread.
 double support_dot(const std::vector<double>& w, const double* x);

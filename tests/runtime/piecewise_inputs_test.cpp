@@ -177,8 +177,8 @@ TEST(HeldInput, SegmentsKeepRulesOffTheKinks) {
   EXPECT_GT(smooth_error, 10 * held_error);
 }
 
-double fitted_error(const std::string& text, const SampledRecord& record, double a, double b) {
-  return testing::largest_relative_error(text, record, {{"a", a}, {"b", b}});
+double fitted_error(const std::string& text, const SampledRecord& record, double a, double b, const FitOptions& options = {}) {
+  return testing::largest_relative_error(text, record, {{"a", a}, {"b", b}}, options);
 }
 
 TEST(HeldInput, FirstOrderSystemIsRecoveredInWeakAndIntegratedForms) {
@@ -186,7 +186,11 @@ TEST(HeldInput, FirstOrderSystemIsRecoveredInWeakAndIntegratedForms) {
   const SampledRecord r = first_order(600, 0.2, a, b);
   const std::string model = "output y\nparam a, b\n";
   const std::string equation = "y' = -a*y + b*x\n";
-  const double weak = fitted_error("input x held\n" + model + "set form = weak\n" + equation, r, a, b);
+  // The quadrature on held segments alone: unweighted rows (weighted by the noise the kinks seem to
+  // carry, 5.0e-4, still two orders below the smooth input's).
+  FitOptions unweighted;
+  unweighted.weak_covariance = false;
+  const double weak = fitted_error("input x held\n" + model + "set form = weak\n" + equation, r, a, b, unweighted);
   const double integrated = fitted_error("input x held\n" + model + "set integrate = 1\n" + equation, r, a, b);
   const double as_smooth = fitted_error("input x\n" + model + "set form = weak\n" + equation, r, a, b);
   // Measured: 2.0e-4 weak, 1.1e-4 integrated (the trapezoid on one-interval segments), 5.6e-2 as smooth.

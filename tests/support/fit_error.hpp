@@ -17,11 +17,12 @@
 namespace sidc::testing {
 
 // max over the parameters named in `truth` of |estimate / truth - 1|; the others are not judged.
-inline double largest_relative_error(const std::string& text, const SampledRecord& record, const std::map<std::string, double>& truth) {
+inline double largest_relative_error(const std::string& text, const SampledRecord& record, const std::map<std::string, double>& truth,
+                                     const FitOptions& options = {}) {
   const CompileResult c = compile(std::make_shared<const SourceFile>("m.sid", text), {});
   EXPECT_TRUE(c.ok()) << c.diagnostics.render_all();
   if (!c.ok()) return 1e9;
-  auto fitted = fit(*c.integrated, {record}, FitOptions{});
+  auto fitted = fit(*c.integrated, {record}, options);
   EXPECT_TRUE(std::holds_alternative<FitSummary>(fitted)) << std::get<Diagnostic>(fitted).message;
   if (!std::holds_alternative<FitSummary>(fitted)) return 1e9;
   double worst = 0;

@@ -379,9 +379,7 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
     std::vector<NoiseBySignal> noise(records.size());
     for (std::size_t r = 0; r < records.size() && r < operators.size(); ++r)
       for (const auto& s : operators[r].noise) noise[r][s.signal] = s.level.sigma;
-    auto weighted = weight_weak_rows(model, evaluators, design, g.equations, w, noise, g.summary, g.columns, options.least_squares);
-    if (auto* d = std::get_if<Diagnostic>(&weighted)) return *d;
-    auto& [summary, how] = std::get<std::pair<LeastSquaresSummary, WeakWeighting>>(weighted);
+    auto [summary, how] = weight_weak_rows(model, evaluators, design, g.equations, w, noise, g.summary, g.columns, options.least_squares);
     g.summary = std::move(summary);
     g.weak_weighting = std::move(how);
   }

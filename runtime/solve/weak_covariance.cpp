@@ -50,8 +50,9 @@ std::variant<std::vector<Sensitivity>, std::string> sensitivities(const ir::Mode
     }
     for (const auto& [k, terms] : parts) {
       const ir::Sum g = ir::canonical(terms);
-      for (const auto& [signal, sigma] : noise) {
-        if (!(sigma > 0)) continue;
+      for (const auto& level : noise) {
+        const std::string& signal = level.first;  // named, not bound: lambdas below capture it
+        if (!(level.second > 0)) continue;
         int highest = -1;
         ir::for_each_factor(g, [&](const ir::Factor& f) {
           if (f.kind == ir::FactorKind::signal && f.name == signal) highest = std::max(highest, f.order);
@@ -98,7 +99,8 @@ struct RowCovariance {
   const std::vector<TestFunctionGrid>& grids;
   std::vector<Evaluator>& evaluators;
 
-  std::variant<Eigen::SparseMatrix<double>, Diagnostic> at(const Eigen::VectorXd& x, Eigen::Index rows) const {
+  // C(x), or why it cannot be had (a derivative that is not finite on the record: sqrt(y) where y = 0).
+  std::variant<Eigen::SparseMatrix<double>, std::string> at(const Eigen::VectorXd& x, Eigen::Index rows) const {
     std::vector<Eigen::Triplet<double>> entries;
     Eigen::Index offset = 0;
     for (std::size_t r = 0; r < grids.size(); ++r) {
@@ -118,8 +120,8 @@ struct RowCovariance {
         }
         for (const auto& [key, sum] : combined) {
           if (sum.terms.empty()) continue;
-          auto values = evaluators[r].evaluate_in_window(sum, "the weak rows' covariance");
-          if (auto* d = std::get_if<Diagnostic>(&values)) return *d;
+          auto values = evaluators[r].evaluate_in_window(sum, "the derivative of the rows by `" + key.second + "`");
+          if (auto* d = std::get_if<Diagnostic>(&values)) return d->message;
           auto& per_equation = slopes[key];
           per_equation.resize(E);
           per_equation[e] = std::get<std::vector<double>>(std::move(values));
@@ -208,18 +210,18 @@ std::vector<double> residuals(const WeakDesign& weak, const LeastSquaresSummary&
 
 }  // namespace
 
-std::variant<Eigen::SparseMatrix<double>, std::string, Diagnostic> weak_row_covariance(
+std::variant<Eigen::SparseMatrix<double>, std::string> weak_row_covariance(
     const ir::Model& model, std::vector<Evaluator>& evaluators, const DesignBuilder& design, const std::vector<std::size_t>& equations,
     const WeakDesign& weak, const std::vector<NoiseBySignal>& noise, const Eigen::VectorXd& x) {
   auto gathered = all_sensitivities(model, design, equations, evaluators.size(), noise);
   if (auto* why = std::get_if<std::string>(&gathered)) return std::move(*why);
   const RowCovariance covariance{std::get<Parts>(gathered), noise, weak.grids, evaluators};
   auto made = covariance.at(x, weak.b.size());
-  if (auto* d = std::get_if<Diagnostic>(&made)) return std::move(*d);
+  if (auto* why = std::get_if<std::string>(&made)) return std::move(*why);
   return std::get<Eigen::SparseMatrix<double>>(std::move(made));
 }
 
-std::variant<std::pair<LeastSquaresSummary, WeakWeighting>, Diagnostic> weight_weak_rows(
+std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
     const ir::Model& model, std::vector<Evaluator>& evaluators, const DesignBuilder& design, const std::vector<std::size_t>& equations,
     const WeakDesign& weak, const std::vector<NoiseBySignal>& noise, const LeastSquaresSummary& unweighted,
     const std::vector<std::string>& columns, const LeastSquaresOptions& options) {
@@ -238,7 +240,7 @@ std::variant<std::pair<LeastSquaresSummary, WeakWeighting>, Diagnostic> weight_w
   LeastSquaresSummary solved = unweighted;
   for (int solve = 1; solve <= kMostSolves; ++solve) {
     auto made = covariance.at(x, weak.b.size());
-    if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
+    if (auto* why = std::get_if<std::string>(&made)) return keep(*why);
     Eigen::SparseMatrix<double>& C = std::get<Eigen::SparseMatrix<double>>(made);
     // A row no noise reaches would be exact; a ridge of 1e-12 of the largest variance keeps C
     // positive definite without changing any row that noise does reach.

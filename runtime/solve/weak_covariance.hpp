@@ -23,8 +23,10 @@
 // Eigen's sparse Cholesky. Guarantees: the rows are left as they are, with a note saying why,
 // where the covariance cannot be written (a signal's derivative estimated from the data still in
 // an operation, an int() or der() of a noisy signal), where no signal is noisy, for weighted rows
-// (eq. 2-1.6), and when the iteration does not settle; otherwise the estimates are those of the
-// last iteration, with the rows' residuals b - A x unweighted as before.
+// (eq. 2-1.6), where a derivative is not finite on the record, when the iteration does not settle
+// and when the noise does not explain the residuals; otherwise the estimates are those of the last
+// iteration, with the rows' residuals b - A x unweighted as before. Never an error: at worst the
+// unweighted fit, as before, with the note.
 #pragma once
 
 #include <cstddef>
@@ -35,7 +37,6 @@
 
 #include <Eigen/SparseCore>
 
-#include "diagnostics/diagnostic.hpp"
 #include "ir/ir.hpp"
 #include "runtime/operators/evaluate.hpp"
 #include "runtime/solve/design.hpp"
@@ -56,14 +57,14 @@ using NoiseBySignal = std::map<std::string, double>;
 
 // The rows' covariance C(x) at the estimates `x` (in the design's column order), rows as
 // weak_design() lays them out; a string says why none can be written (see above).
-std::variant<Eigen::SparseMatrix<double>, std::string, Diagnostic> weak_row_covariance(
+std::variant<Eigen::SparseMatrix<double>, std::string> weak_row_covariance(
     const ir::Model& model, std::vector<Evaluator>& evaluators, const DesignBuilder& design, const std::vector<std::size_t>& equations,
     const WeakDesign& weak, const std::vector<NoiseBySignal>& noise, const Eigen::VectorXd& x);
 
 // Re-solves the weak group `equations` (its design `weak`, of `design`'s columns over the records
 // of `evaluators`) by iterated generalised least squares from the unweighted solution `unweighted`.
 // Returns the summary to keep (`unweighted` when the weighting does not apply) and how it was made.
-std::variant<std::pair<LeastSquaresSummary, WeakWeighting>, Diagnostic> weight_weak_rows(
+std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
     const ir::Model& model, std::vector<Evaluator>& evaluators, const DesignBuilder& design, const std::vector<std::size_t>& equations,
     const WeakDesign& weak, const std::vector<NoiseBySignal>& noise, const LeastSquaresSummary& unweighted,
     const std::vector<std::string>& columns, const LeastSquaresOptions& options);

@@ -208,6 +208,60 @@ std::vector<double> residuals(const WeakDesign& weak, const LeastSquaresSummary&
   return {r.data(), r.data() + r.size()};
 }
 
+// Per row and column (and for the known side), sum_k integral(phi_j^(k) * 1/2 sum_s sigma_s^2
+// d^2 g_k / ds^2): the rows' mean shift under the noise to second order, at unit noise scale.
+std::variant<std::pair<Eigen::MatrixXd, Eigen::VectorXd>, std::string> mean_shift(
+    const ir::Model& model, const DesignBuilder& design, const std::vector<std::size_t>& equations, std::vector<Evaluator>& evaluators,
+    const std::vector<TestFunctionGrid>& grids, const std::vector<NoiseBySignal>& noise) {
+  Eigen::Index rows = 0;
+  for (const auto& g : grids) rows += static_cast<Eigen::Index>(g.centres.size() * equations.size());
+  std::pair<Eigen::MatrixXd, Eigen::VectorXd> out{Eigen::MatrixXd::Zero(rows, static_cast<Eigen::Index>(design.columns().size())),
+                                                  Eigen::VectorXd::Zero(rows)};
+  Eigen::Index offset = 0;
+  for (std::size_t r = 0; r < grids.size(); ++r) {
+    const TestFunctionGrid& grid = grids[r];
+    const auto K = static_cast<Eigen::Index>(grid.centres.size());
+    for (std::size_t e = 0; e < equations.size(); ++e) {
+      const ir::Equation& eq = model.equations[equations[e]];
+      // One sum and its place: a column of A, or b (none).
+      const auto add = [&](const ir::Sum& sum, std::optional<std::size_t> column) -> std::optional<std::string> {
+        std::map<int, std::vector<ir::Term>> by_order;
+        for (const auto& t : sum.terms) {
+          auto [k, rest] = split_test_function(t);
+          by_order[k].push_back(ir::canonical(rest));
+        }
+        for (const auto& [k, terms] : by_order) {
+          const ir::Sum g = ir::canonical(terms);
+          ir::Sum curvature;
+          for (const auto& [signal, sigma] : noise[r]) {
+            if (!(sigma > 0)) continue;
+            auto once = partial_derivative(g, signal, 0);
+            auto twice = once ? partial_derivative(*once, signal, 0) : std::nullopt;
+            if (!twice) return fmt::format("an int() or der() of `{}` in `{}`", signal, print(g));
+            curvature = ir::add(curvature, ir::scale(*twice, Number::real(sigma * sigma / 2)));
+          }
+          if (curvature.terms.empty()) continue;
+          auto values = evaluators[r].evaluate_in_window(curvature, "the curvature of the rows");
+          if (auto* d = std::get_if<Diagnostic>(&values)) return d->message;
+          const auto& v = std::get<std::vector<double>>(values);
+          const std::vector<double> w = test_function_weights(grid, k, evaluators[r].record().step);
+          for (Eigen::Index j = 0; j < K; ++j) {
+            const double value = support_dot(w, v.data() + (grid.centres[static_cast<std::size_t>(j)] - grid.half_width));
+            if (column) out.first(offset + j, static_cast<Eigen::Index>(*column)) += value;
+            else out.second(offset + j) += value;
+          }
+        }
+        return std::nullopt;
+      };
+      for (const auto& term : eq.terms)
+        if (auto why = add(term.operation, design.column(term.parameter, r))) return *why;
+      if (auto why = add(eq.known, std::nullopt)) return *why;
+      offset += K;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::variant<Eigen::SparseMatrix<double>, std::string> weak_row_covariance(
@@ -238,47 +292,67 @@ std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
   Eigen::VectorXd x(static_cast<Eigen::Index>(unweighted.parameters.size()));
   for (std::size_t c = 0; c < unweighted.parameters.size(); ++c) x(static_cast<Eigen::Index>(c)) = unweighted.parameters[c].value;
   LeastSquaresSummary solved = unweighted;
-  for (int solve = 1; solve <= kMostSolves; ++solve) {
-    auto made = covariance.at(x, weak.b.size());
-    if (auto* why = std::get_if<std::string>(&made)) return keep(*why);
-    Eigen::SparseMatrix<double>& C = std::get<Eigen::SparseMatrix<double>>(made);
-    // A row no noise reaches would be exact; a ridge of 1e-12 of the largest variance keeps C
-    // positive definite without changing any row that noise does reach.
-    double largest = 0;
-    for (Eigen::Index i = 0; i < C.rows(); ++i) largest = std::max(largest, C.coeff(i, i));
-    if (!(largest > 0) || !std::isfinite(largest)) return keep("the rows' covariance is zero or not finite");
-    for (Eigen::Index i = 0; i < C.rows(); ++i) C.coeffRef(i, i) += 1e-12 * largest;
-    Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> factor(C);
-    if (factor.info() != Eigen::Success) return keep("the rows' covariance is not positive definite");
-    const Eigen::MatrixXd A = factor.matrixL().solve(Eigen::MatrixXd(factor.permutationP() * weak.A));
-    const Eigen::VectorXd b = factor.matrixL().solve(Eigen::VectorXd(factor.permutationP() * weak.b));
-    LeastSquaresSummary next = solve_least_squares(A, b, columns, nullptr, options);
-    if (!next.is_solution_usable()) return keep("a weighted solve was not usable (" + next.message + ")");
-    Eigen::VectorXd y(x.size());
-    for (std::size_t c = 0; c < next.parameters.size(); ++c) y(static_cast<Eigen::Index>(c)) = next.parameters[c].value;
-    const double change = (y - x).lpNorm<Eigen::Infinity>() / std::max(y.lpNorm<Eigen::Infinity>(), 1e-300);
-    x = y;
-    solved = std::move(next);
-    how.iterations = solve;
-    if (change <= kSettled) {
-      how.applied = true;
-      break;
+  // Generalised least squares on rows [A b], C recomputed at each new x until x settles; a reason
+  // when it cannot go on.
+  const auto iterate = [&](const Eigen::MatrixXd& A0, const Eigen::VectorXd& b0) -> std::optional<std::string> {
+    for (int solve = 1; solve <= kMostSolves; ++solve) {
+      auto made = covariance.at(x, b0.size());
+      if (auto* why = std::get_if<std::string>(&made)) return *why;
+      Eigen::SparseMatrix<double>& C = std::get<Eigen::SparseMatrix<double>>(made);
+      // A row no noise reaches would be exact; a ridge of 1e-12 of the largest variance keeps C
+      // positive definite without changing any row that noise does reach.
+      double largest = 0;
+      for (Eigen::Index i = 0; i < C.rows(); ++i) largest = std::max(largest, C.coeff(i, i));
+      if (!(largest > 0) || !std::isfinite(largest)) return std::string("the rows' covariance is zero or not finite");
+      for (Eigen::Index i = 0; i < C.rows(); ++i) C.coeffRef(i, i) += 1e-12 * largest;
+      Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> factor(C);
+      if (factor.info() != Eigen::Success) return std::string("the rows' covariance is not positive definite");
+      const Eigen::MatrixXd A = factor.matrixL().solve(Eigen::MatrixXd(factor.permutationP() * A0));
+      const Eigen::VectorXd b = factor.matrixL().solve(Eigen::VectorXd(factor.permutationP() * b0));
+      LeastSquaresSummary next = solve_least_squares(A, b, columns, nullptr, options);
+      if (!next.is_solution_usable()) return "a weighted solve was not usable (" + next.message + ")";
+      Eigen::VectorXd y(x.size());
+      for (std::size_t c = 0; c < next.parameters.size(); ++c) y(static_cast<Eigen::Index>(c)) = next.parameters[c].value;
+      const double change = (y - x).lpNorm<Eigen::Infinity>() / std::max(y.lpNorm<Eigen::Infinity>(), 1e-300);
+      x = y;
+      solved = std::move(next);
+      ++how.iterations;
+      how.residual_variance = solved.residual_sd * solved.residual_sd;
+      if (change <= kSettled) return std::nullopt;
     }
-  }
-  how.residual_variance = solved.residual_sd * solved.residual_sd;
-  if (!how.applied) return keep(fmt::format("the iteration did not settle in {} solves", kMostSolves));
-  if (!(how.residual_variance <= kMostResidualVariance)) {
-    how.applied = false;
+    return fmt::format("the iteration did not settle in {} solves", kMostSolves);
+  };
+  const auto noise_dominates = [&] { return how.residual_variance <= kMostResidualVariance; };
+  const auto dominated = [&] {
     return keep(fmt::format("weighted, their residuals are {:.3g} times what the signals' noise levels explain, so something else "
                             "dominates them (a term the model lacks, or the discretisation of a record with little noise)",
                             std::sqrt(how.residual_variance)));
+  };
+  if (auto why = iterate(weak.A, weak.b)) return keep(*why);
+  if (!noise_dominates()) return dominated();
+  // The operations' mean shift under noise, E g(s + e) - g(s) = sigma^2 g''(s) / 2 (exact for a
+  // cubic: E (y + e)^3 = y^3 + 3 sigma^2 y), taken out of the rows with the noise variance the
+  // weighted residuals calibrate (their variance times each signal's estimated one), then fitted again.
+  auto shift = mean_shift(model, design, equations, evaluators, weak.grids, noise);
+  if (auto* why = std::get_if<std::string>(&shift)) return keep(*why);
+  const auto& [dA, db] = std::get<std::pair<Eigen::MatrixXd, Eigen::VectorXd>>(shift);
+  const double scale = how.residual_variance;
+  const bool shifted = dA.any() || db.any();  // any(): some entry is not zero
+  WeakDesign fitted;
+  fitted.A = weak.A - scale * dA;
+  fitted.b = weak.b - scale * db;
+  if (shifted) {
+    if (auto why = iterate(fitted.A, fitted.b)) return keep(*why);
+    if (!noise_dominates()) return dominated();
   }
-  solved.residuals = residuals(weak, solved);
+  how.applied = true;
+  solved.residuals = residuals(fitted, solved);
   how.note = fmt::format(
-      "rows weighted by the covariance their noise gives them (generalised least squares, iterated: WENDy, {} solve{}); "
+      "rows weighted by the covariance their noise gives them (generalised least squares, iterated: WENDy, {} solve{}){}; "
       "residual variance of the weighted rows {:.3g} (about 1 when the noise explains the residuals); G(a) and the statistics "
       "below are the weighted rows'",
-      how.iterations, how.iterations == 1 ? "" : "s", how.residual_variance);
+      how.iterations, how.iterations == 1 ? "" : "s",
+      shifted ? ", the operations' mean shift under the noise, sigma^2 g''/2, taken out" : "", how.residual_variance);
   return std::pair{std::move(solved), how};
 }
 

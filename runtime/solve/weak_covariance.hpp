@@ -16,7 +16,13 @@
 // overlap). The fit solves C^-1/2 A x = C^-1/2 b by the same least squares (QR), recomputes C at
 // the new x, and repeats until x settles; the intervals are then those of whitened, independent
 // rows. Only the relative noise levels matter: the residual variance is estimated from the fit as
-// before (it is about 1 when the noise explains the residuals, and is reported).
+// before (it is about 1 when the noise explains the residuals, and is reported). Then, to second
+// order, each operation's mean shift under the noise, E g(s + e) - g(s) = sum_s sigma_s^2 g''/2
+// (exact for cubics: E (y + e)^3 = y^3 + 3 sigma^2 y), is taken out of the rows, with the noise
+// variances scaled by that residual variance (the fit calibrates the estimator's levels), and the
+// rows are fitted again: on long records, where the random error is small, the shift would
+// otherwise be the error (k of a Duffing record of 10^6 samples at 1% noise: 1.3e-4 off, 2.7
+// standard errors).
 //
 // Relies on: ir/differentiate.hpp (partial_derivative of each part by each signal), evaluate.hpp
 // (the derivatives on each record's window), test_functions.hpp (phi's quadrature weights),

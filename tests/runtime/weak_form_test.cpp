@@ -372,5 +372,34 @@ TEST(WeakCovariance, WeightedRowsGiveSmallerErrorsAndHonestIntervals) {
   EXPECT_GE(covered, 56) << covered << " of " << intervals;  // 87.5%: a binomial(64, 0.95) falls below it with probability < 1%
 }
 
+// On a long record the random error shrinks below the operations' mean shift under the noise:
+// E (y + e)^3 = y^3 + 3 sigma^2 y moves k by -3 k3 sigma^2 (1.2e-3 here, about five standard
+// errors), unless the rows are corrected for it, as the weighting does.
+TEST(WeakCovariance, TakesTheOperationsMeanShiftUnderNoiseOut) {
+  const auto duffing = [](double y, double v, double x) { return x - 0.25 * v - y - 0.5 * y * y * y; };
+  const SampledRecord record = simulate(duffing, forcing, 400000, 0.01, 0.03, 11);
+  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", "input x\noutput y\nparam m, c, k, k3\nset form = weak\n"
+                                                                         "m*y'' + c*y' + k*y + k3*y^3 = x\n"),
+                            {});
+  ASSERT_TRUE(c.ok()) << c.diagnostics.render_all();
+  auto fitted = fit(*c.integrated, {record}, FitOptions{});
+  ASSERT_TRUE(std::holds_alternative<FitSummary>(fitted));
+  const GroupFit& g = std::get<FitSummary>(fitted).groups.front();
+  ASSERT_TRUE(g.weak_weighting.applied) << g.weak_weighting.note;
+  EXPECT_NE(g.weak_weighting.note.find("mean shift"), std::string::npos) << g.weak_weighting.note;
+  const std::map<std::string, double> truth{{"m", 1.0}, {"c", 0.25}, {"k", 1.0}, {"k3", 0.5}};
+  for (const auto& p : g.summary.parameters) {
+    const double t = truth.at(p.name);
+    EXPECT_LT(std::abs(p.value - t), 3 * p.standard_error) << p.name << " = " << p.value << " +- " << p.standard_error;
+  }
+  EXPECT_LT(std::abs(g.summary.parameters[2].value - 1.0), 0.6e-3) << "k, whose mean shift is -1.2e-3";
+  // The same rows unweighted and uncorrected carry the shift.
+  FitOptions plain;
+  plain.weak_covariance = false;
+  auto biased = fit(*c.integrated, {record}, plain);
+  ASSERT_TRUE(std::holds_alternative<FitSummary>(biased));
+  EXPECT_LT(std::get<FitSummary>(biased).groups.front().summary.parameters[2].value, 1.0 - 0.8e-3);
+}
+
 }  // namespace
 }  // namespace sidc

@@ -90,6 +90,21 @@ std::variant<std::vector<Sensitivity>, std::string> sensitivities(const ir::Mode
   return out;
 }
 
+// sum_i a[i] * b[i] over n values in four running sums (as support_dot: one sum would wait on each
+// addition in turn; this is the covariance's innermost loop).
+double shifted_dot(const double* a, const double* b, std::size_t n) {
+  const std::size_t whole = n - n % 4;
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  for (std::size_t i = 0; i < whole; i += 4) {
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
+  }
+  for (std::size_t i = whole; i < n; ++i) s0 += a[i] * b[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
 // The rows' covariance C(x) over every record (block diagonal: records' noises are independent),
 // rows laid out as weak_design() lays them: record by record, equation by equation, subdomain by
 // subdomain. Entries are accumulated in a fixed order, so the result is the same on every run.
@@ -137,6 +152,8 @@ struct RowCovariance {
       };
       std::deque<Row> band;
       const std::size_t S = signals.size();
+      std::vector<double> variance(S);
+      for (std::size_t s = 0; s < S; ++s) variance[s] = noise[r].at(signals[s]) * noise[r].at(signals[s]);
       for (std::size_t j = 0; j < K; ++j) {
         Row row{j, grid.centres[j], std::vector<std::vector<double>>(E * S, std::vector<double>(width, 0.0))};
         const std::size_t start = row.centre - m;
@@ -152,31 +169,27 @@ struct RowCovariance {
         while (!band.empty() && band.front().centre + 2 * m < row.centre) band.pop_front();
         band.push_back(std::move(row));
         const Row& now = band.back();
+        // The lower triangle only (what the Cholesky factor reads), each pair of rows once.
         for (const Row& before : band) {
           const std::size_t shift = now.centre - before.centre;  // now's support starts `shift` samples later
           const std::size_t jb = before.index;
           for (std::size_t e1 = 0; e1 < E; ++e1)
-            for (std::size_t e2 = 0; e2 < E; ++e2) {
+            for (std::size_t e2 = jb == j ? e1 : 0; e2 < E; ++e2) {
               double c = 0;
               for (std::size_t s = 0; s < S; ++s) {
-                const double sigma = noise[r].at(signals[s]);
                 const std::vector<double>& a = before.l[e1 * S + s];
                 const std::vector<double>& b = now.l[e2 * S + s];
-                double dot = 0;
-                for (std::size_t i = shift; i < width; ++i) dot += a[i] * b[i - shift];
-                c += sigma * sigma * dot;
+                c += variance[s] * shifted_dot(a.data() + shift, b.data(), width - shift);
               }
               if (c == 0.0) continue;
-              const Eigen::Index row_before = offset + static_cast<Eigen::Index>(e1 * K + jb);
-              const Eigen::Index row_now = offset + static_cast<Eigen::Index>(e2 * K + j);
-              entries.emplace_back(row_now, row_before, c);
-              if (jb != j) entries.emplace_back(row_before, row_now, c);  // on one subdomain the (e2, e1) pass writes the mirror
+              const Eigen::Index p = offset + static_cast<Eigen::Index>(e1 * K + jb), q = offset + static_cast<Eigen::Index>(e2 * K + j);
+              entries.emplace_back(std::max(p, q), std::min(p, q), c);
             }
         }
       }
       offset += static_cast<Eigen::Index>(E * K);
     }
-    Eigen::SparseMatrix<double> C(rows, rows);
+    Eigen::SparseMatrix<double> C(rows, rows);  // its lower triangle
     C.setFromTriplets(entries.begin(), entries.end());
     return C;
   }
@@ -272,7 +285,8 @@ std::variant<Eigen::SparseMatrix<double>, std::string> weak_row_covariance(
   const RowCovariance covariance{std::get<Parts>(gathered), noise, weak.grids, evaluators};
   auto made = covariance.at(x, weak.b.size());
   if (auto* why = std::get_if<std::string>(&made)) return std::move(*why);
-  return std::get<Eigen::SparseMatrix<double>>(std::move(made));
+  Eigen::SparseMatrix<double> full = std::get<Eigen::SparseMatrix<double>>(made).selfadjointView<Eigen::Lower>();
+  return full;
 }
 
 std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
@@ -294,8 +308,8 @@ std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
   LeastSquaresSummary solved = unweighted;
   // Generalised least squares on rows [A b], C recomputed at each new x until x settles; a reason
   // when it cannot go on.
-  const auto iterate = [&](const Eigen::MatrixXd& A0, const Eigen::VectorXd& b0) -> std::optional<std::string> {
-    for (int solve = 1; solve <= kMostSolves; ++solve) {
+  const auto iterate = [&](const Eigen::MatrixXd& A0, const Eigen::VectorXd& b0, int most) -> std::optional<std::string> {
+    for (int solve = 1; solve <= most; ++solve) {
       auto made = covariance.at(x, b0.size());
       if (auto* why = std::get_if<std::string>(&made)) return *why;
       Eigen::SparseMatrix<double>& C = std::get<Eigen::SparseMatrix<double>>(made);
@@ -318,7 +332,7 @@ std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
       solved = std::move(next);
       ++how.iterations;
       how.residual_variance = solved.residual_sd * solved.residual_sd;
-      if (change <= kSettled) return std::nullopt;
+      if (change <= kSettled || (solve == most && most < kMostSolves)) return std::nullopt;  // settled, or as many solves as asked
     }
     return fmt::format("the iteration did not settle in {} solves", kMostSolves);
   };
@@ -328,21 +342,21 @@ std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
                             "dominates them (a term the model lacks, or the discretisation of a record with little noise)",
                             std::sqrt(how.residual_variance)));
   };
-  if (auto why = iterate(weak.A, weak.b)) return keep(*why);
-  if (!noise_dominates()) return dominated();
   // The operations' mean shift under noise, E g(s + e) - g(s) = sigma^2 g''(s) / 2 (exact for a
-  // cubic: E (y + e)^3 = y^3 + 3 sigma^2 y), taken out of the rows with the noise variance the
-  // weighted residuals calibrate (their variance times each signal's estimated one), then fitted again.
+  // cubic: E (y + e)^3 = y^3 + 3 sigma^2 y), is taken out of the rows with the noise variances the
+  // weighted residuals calibrate (their variance times each signal's estimated one). Where there is
+  // one, a first weighted solve calibrates and the corrected rows are iterated until they settle.
   auto shift = mean_shift(model, design, equations, evaluators, weak.grids, noise);
   if (auto* why = std::get_if<std::string>(&shift)) return keep(*why);
   const auto& [dA, db] = std::get<std::pair<Eigen::MatrixXd, Eigen::VectorXd>>(shift);
-  const double scale = how.residual_variance;
   const bool shifted = dA.any() || db.any();  // any(): some entry is not zero
+  if (auto why = iterate(weak.A, weak.b, shifted ? 1 : kMostSolves)) return keep(*why);
+  if (!noise_dominates()) return dominated();
   WeakDesign fitted;
-  fitted.A = weak.A - scale * dA;
-  fitted.b = weak.b - scale * db;
+  fitted.A = weak.A - how.residual_variance * dA;
+  fitted.b = weak.b - how.residual_variance * db;
   if (shifted) {
-    if (auto why = iterate(fitted.A, fitted.b)) return keep(*why);
+    if (auto why = iterate(fitted.A, fitted.b, kMostSolves)) return keep(*why);
     if (!noise_dominates()) return dominated();
   }
   how.applied = true;

@@ -90,21 +90,6 @@ std::variant<std::vector<Sensitivity>, std::string> sensitivities(const ir::Mode
   return out;
 }
 
-// sum_i a[i] * b[i] over n values in four running sums (as support_dot: one sum would wait on each
-// addition in turn; this is the covariance's innermost loop).
-double shifted_dot(const double* a, const double* b, std::size_t n) {
-  const std::size_t whole = n - n % 4;
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  for (std::size_t i = 0; i < whole; i += 4) {
-    s0 += a[i] * b[i];
-    s1 += a[i + 1] * b[i + 1];
-    s2 += a[i + 2] * b[i + 2];
-    s3 += a[i + 3] * b[i + 3];
-  }
-  for (std::size_t i = whole; i < n; ++i) s0 += a[i] * b[i];
-  return (s0 + s1) + (s2 + s3);
-}
-
 // The rows' covariance C(x) over every record (block diagonal: records' noises are independent),
 // rows laid out as weak_design() lays them: record by record, equation by equation, subdomain by
 // subdomain. Entries are accumulated in a fixed order, so the result is the same on every run.
@@ -179,7 +164,7 @@ struct RowCovariance {
               for (std::size_t s = 0; s < S; ++s) {
                 const std::vector<double>& a = before.l[e1 * S + s];
                 const std::vector<double>& b = now.l[e2 * S + s];
-                c += variance[s] * shifted_dot(a.data() + shift, b.data(), width - shift);
+                c += variance[s] * running_dot(a.data() + shift, b.data(), width - shift);  // the covariance's innermost loop
               }
               if (c == 0.0) continue;
               const Eigen::Index p = offset + static_cast<Eigen::Index>(e1 * K + jb), q = offset + static_cast<Eigen::Index>(e2 * K + j);

@@ -52,22 +52,24 @@ std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
   return {order, rest};
 }
 
-// sum_i w[i] * x[i] over a test function's support (thousands of samples) in four running sums,
-// added pairwise at the end: one sum would wait on each addition in turn (a latency of four
-// cycles per product); four keep the multiply-add units busy. The order is fixed, so the result is
-// the same on every run and thread.
-double support_dot(const std::vector<double>& w, const double* x) {
-  const std::size_t n = w.size(), whole = n - n % 4;
+// sum_i a[i] * b[i] in four running sums, added pairwise at the end: one sum would wait on each
+// addition in turn (a latency of four cycles per product); four keep the multiply-add units busy.
+// The order is fixed, so the result is the same on every run and thread.
+double running_dot(const double* a, const double* b, std::size_t n) {
+  const std::size_t whole = n - n % 4;
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
   for (std::size_t i = 0; i < whole; i += 4) {
-    s0 += w[i] * x[i];
-    s1 += w[i + 1] * x[i + 1];
-    s2 += w[i + 2] * x[i + 2];
-    s3 += w[i + 3] * x[i + 3];
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
   }
-  for (std::size_t i = whole; i < n; ++i) s0 += w[i] * x[i];
+  for (std::size_t i = whole; i < n; ++i) s0 += a[i] * b[i];
   return (s0 + s1) + (s2 + s3);
 }
+
+// Over a test function's support (thousands of samples).
+double support_dot(const std::vector<double>& w, const double* x) { return running_dot(w.data(), x, w.size()); }
 
 std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations) {
   const auto weak = std::count_if(equations.begin(), equations.end(), [&](std::size_t e) { return model.equations[e].weak; });

@@ -34,6 +34,9 @@ std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::
 // exactly one, to the power 1, on every term; the compiled-model reader checks files for the same).
 std::pair<int, ir::Term> split_test_function(const ir::Term& t);
 
+// sum_i a[i] * b[i] over n values, summed in a fixed order (the same result on every run and thread).
+double running_dot(const double* a, const double* b, std::size_t n);
+
 // sum_i w[i] * x[i] over a support (w.size() values from x): each row's integral, summed in a fixed
 // order, so that the result is the same on every run and thread.
 double support_dot(const std::vector<double>& w, const double* x);

@@ -270,6 +270,10 @@ TEST(WeakValues, AValueThatIsNotFiniteIsNamedAsOnTheWholeWindow) {
   }
 }
 
+// The Duffing oscillator of the tests below, and its model in the weak form.
+const auto duffing_oscillator = [](double y, double v, double x) { return x - 0.25 * v - y - 0.5 * y * y * y; };
+const char* const kWeakDuffing = "input x\noutput y\nparam m, c, k, k3\nset form = weak\nm*y'' + c*y' + k*y + k3*y^3 = x\n";
+
 // The weak design of `model`'s only equation on `record`, on the grid given.
 WeakDesign design_on(const ir::Model& model, const SampledRecord& record, const TestFunctionGrid& grid) {
   const FitWindow window{0, record.time.size() - 1};
@@ -286,11 +290,8 @@ WeakDesign design_on(const ir::Model& model, const SampledRecord& record, const 
 }
 
 TEST(WeakCovariance, IsTheFirstOrderCovarianceOfTheRowsResiduals) {
-  const auto duffing = [](double y, double v, double x) { return x - 0.25 * v - y - 0.5 * y * y * y; };
-  const SampledRecord record = simulate(duffing, forcing, 400, 0.05, 0.01, 5);
-  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", "input x\noutput y\nparam m, c, k, k3\nset form = weak\n"
-                                                                         "m*y'' + c*y' + k*y + k3*y^3 = x\n"),
-                            {});
+  const SampledRecord record = simulate(duffing_oscillator, forcing, 400, 0.05, 0.01, 5);
+  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", kWeakDuffing), {});
   ASSERT_TRUE(c.ok()) << c.diagnostics.render_all();
   const ir::Model& model = *c.integrated;
   const TestFunctionGrid grid = grid_every(20, 6, record.time.size());
@@ -338,17 +339,15 @@ TEST(WeakCovariance, IsTheFirstOrderCovarianceOfTheRowsResiduals) {
 }
 
 TEST(WeakCovariance, WeightedRowsGiveSmallerErrorsAndHonestIntervals) {
-  const auto duffing = [](double y, double v, double x) { return x - 0.25 * v - y - 0.5 * y * y * y; };
   const std::map<std::string, double> truth{{"m", 1.0}, {"c", 0.25}, {"k", 1.0}, {"k3", 0.5}};
-  const std::string text = "input x\noutput y\nparam m, c, k, k3\nset form = weak\nm*y'' + c*y' + k*y + k3*y^3 = x\n";
-  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", text), {});
+  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", kWeakDuffing), {});
   ASSERT_TRUE(c.ok()) << c.diagnostics.render_all();
   FitOptions unweighted;
   unweighted.weak_covariance = false;
   double weighted_error = 0, unweighted_error = 0;
   int covered = 0, intervals = 0;
   for (unsigned seed = 1; seed <= 16; ++seed) {
-    const SampledRecord record = simulate(duffing, forcing, 3000, 0.05, 0.01, seed);
+    const SampledRecord record = simulate(duffing_oscillator, forcing, 3000, 0.05, 0.01, seed);
     auto weighted = fit(*c.integrated, {record}, FitOptions{});
     auto plain = fit(*c.integrated, {record}, unweighted);
     ASSERT_TRUE(std::holds_alternative<FitSummary>(weighted) && std::holds_alternative<FitSummary>(plain));
@@ -376,11 +375,8 @@ TEST(WeakCovariance, WeightedRowsGiveSmallerErrorsAndHonestIntervals) {
 // E (y + e)^3 = y^3 + 3 sigma^2 y moves k by -3 k3 sigma^2 (1.2e-3 here, about five standard
 // errors), unless the rows are corrected for it, as the weighting does.
 TEST(WeakCovariance, TakesTheOperationsMeanShiftUnderNoiseOut) {
-  const auto duffing = [](double y, double v, double x) { return x - 0.25 * v - y - 0.5 * y * y * y; };
-  const SampledRecord record = simulate(duffing, forcing, 400000, 0.01, 0.03, 11);
-  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", "input x\noutput y\nparam m, c, k, k3\nset form = weak\n"
-                                                                         "m*y'' + c*y' + k*y + k3*y^3 = x\n"),
-                            {});
+  const SampledRecord record = simulate(duffing_oscillator, forcing, 400000, 0.01, 0.03, 11);
+  CompileResult c = compile(std::make_shared<const SourceFile>("d.sid", kWeakDuffing), {});
   ASSERT_TRUE(c.ok()) << c.diagnostics.render_all();
   auto fitted = fit(*c.integrated, {record}, FitOptions{});
   ASSERT_TRUE(std::holds_alternative<FitSummary>(fitted));

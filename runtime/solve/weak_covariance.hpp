@@ -27,12 +27,13 @@
 // Relies on: ir/differentiate.hpp (partial_derivative of each part by each signal), evaluate.hpp
 // (the derivatives on each record's window), test_functions.hpp (phi's quadrature weights),
 // Eigen's sparse Cholesky. Guarantees: the rows are left as they are, with a note saying why,
-// where the covariance cannot be written (a signal's derivative estimated from the data still in
-// an operation, an int() or der() of a noisy signal), where no signal is noisy, for weighted rows
-// (eq. 2-1.6), where a derivative is not finite on the record, when the iteration does not settle
-// and when the noise does not explain the residuals; otherwise the estimates are those of the last
-// iteration, with the rows' residuals b - A x unweighted as before. Never an error: at worst the
-// unweighted fit, as before, with the note.
+// where the covariance cannot be written (a guard or sign() on a noisy signal, a signal's
+// derivative estimated from the data still in an operation, an int() or der() of a noisy signal),
+// where no signal is noisy, for weighted rows (eq. 2-1.6), where a derivative is not finite on the
+// record, when the iteration does not settle and when the noise does not explain the residuals
+// (their weighted variance above 4); otherwise the estimates are those of the last iteration, with
+// the residuals b - A x of the corrected rows, unweighted. Never an error: at worst the unweighted
+// fit, as before, with the note.
 #pragma once
 
 #include <cstddef>
@@ -53,7 +54,7 @@ namespace sidc {
 
 struct WeakWeighting {
   bool applied = false;
-  int iterations = 0;        // generalised least-squares solves after the first, unweighted one
+  int iterations = 0;        // weighted solves after the first, unweighted one
   double residual_variance = 0;  // of the whitened rows: about 1 when the noise levels explain the residuals
   std::string note;          // how, or why not: one line for the report and fit.json
 };

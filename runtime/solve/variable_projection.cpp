@@ -15,6 +15,13 @@ namespace {
 
 constexpr double kInfinite = std::numeric_limits<double>::infinity();
 
+// `options` with the weak form's rows unweighted: G is compared between trial values, and rows
+// whitened by their noise covariance (weak_covariance.hpp) would change their metric with each.
+FitOptions unweighted(FitOptions options) {
+  options.weak_covariance = false;
+  return options;
+}
+
 // eq. 2-1.7 summed over the equation groups.
 double total_G(const FitSummary& s) {
   double total = 0;
@@ -156,11 +163,8 @@ std::variant<VariableProjectionSummary, Diagnostic> variable_projection(const ir
     out.names.push_back(p.name);
     out.guesses.push_back(p.guess ? p.guess->value() : 0.0);
   }
-  // G of unweighted rows at every trial: whitened rows (weak_covariance.hpp) would change their
-  // metric with the trial values.
-  FitOptions unweighted = options;
-  unweighted.weak_covariance = false;
-  Objective f(model, records, unweighted, nonlinear, projection.max_fits);
+  const FitOptions searched = unweighted(options);  // Objective keeps a reference
+  Objective f(model, records, searched, nonlinear, projection.max_fits);
   auto at_guess = f(out.guesses);
   if (auto* d = std::get_if<Diagnostic>(&at_guess)) return *d;
   out.G_guess = std::get<double>(at_guess);
@@ -264,12 +268,11 @@ NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector
     return out;
   }
   // The fit with the nonlinear parameters moved by `shift` (per nonlinear parameter).
-  FitOptions unweighted = options;  // as the search's fits
-  unweighted.weak_covariance = false;
+  const FitOptions as_searched = unweighted(options);
   const auto fitted_at = [&](const std::vector<double>& shift) -> std::optional<FitSummary> {
     std::vector<double> values = held;
     for (std::size_t k = 0; k < m; ++k) values[nonlinear[k]] += shift[k];
-    auto r = fit(fix_nonlinear(model, values), records, unweighted);
+    auto r = fit(fix_nonlinear(model, values), records, as_searched);
     if (auto* s = std::get_if<FitSummary>(&r); s && s->is_solution_usable()) return std::move(*s);
     return std::nullopt;
   };

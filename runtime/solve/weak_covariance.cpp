@@ -207,53 +207,42 @@ std::vector<double> residuals(const WeakDesign& weak, const LeastSquaresSummary&
 }
 
 // Per row and column (and for the known side), sum_k integral(phi_j^(k) * 1/2 sum_s sigma_s^2
-// d^2 g_k / ds^2): the rows' mean shift under the noise to second order, at unit noise scale.
-std::variant<std::pair<Eigen::MatrixXd, Eigen::VectorXd>, std::string> mean_shift(
-    const ir::Model& model, const DesignBuilder& design, const std::vector<std::size_t>& equations, std::vector<Evaluator>& evaluators,
-    const std::vector<TestFunctionGrid>& grids, const std::vector<NoiseBySignal>& noise) {
+// d^2 g_k / ds^2): the rows' mean shift under the noise to second order, at unit noise scale. The
+// second derivatives are those of the sensitivities' first ones (`parts`).
+std::variant<std::pair<Eigen::MatrixXd, Eigen::VectorXd>, std::string> mean_shift(const Parts& parts, const DesignBuilder& design,
+                                                                                  std::vector<Evaluator>& evaluators,
+                                                                                  const std::vector<TestFunctionGrid>& grids,
+                                                                                  const std::vector<NoiseBySignal>& noise) {
   Eigen::Index rows = 0;
-  for (const auto& g : grids) rows += static_cast<Eigen::Index>(g.centres.size() * equations.size());
+  for (std::size_t r = 0; r < grids.size(); ++r) rows += static_cast<Eigen::Index>(grids[r].centres.size() * parts[r].size());
   std::pair<Eigen::MatrixXd, Eigen::VectorXd> out{Eigen::MatrixXd::Zero(rows, static_cast<Eigen::Index>(design.columns().size())),
                                                   Eigen::VectorXd::Zero(rows)};
   Eigen::Index offset = 0;
   for (std::size_t r = 0; r < grids.size(); ++r) {
     const TestFunctionGrid& grid = grids[r];
     const auto K = static_cast<Eigen::Index>(grid.centres.size());
-    for (std::size_t e = 0; e < equations.size(); ++e) {
-      const ir::Equation& eq = model.equations[equations[e]];
-      // One sum and its place: a column of A, or b (none).
-      const auto add = [&](const ir::Sum& sum, std::optional<std::size_t> column) -> std::optional<std::string> {
-        std::map<int, std::vector<ir::Term>> by_order;
-        for (const auto& t : sum.terms) {
-          auto [k, rest] = split_test_function(t);
-          by_order[k].push_back(ir::canonical(rest));
+    for (const auto& equation : parts[r]) {
+      // sum_s sigma_s^2 / 2 d^2 g / ds^2 by (column, order of phi); the known side has no column.
+      std::map<std::pair<std::optional<std::size_t>, int>, ir::Sum> curvature;
+      for (const Sensitivity& s : equation) {
+        auto twice = partial_derivative(s.derivative, s.signal, 0);
+        if (!twice) return fmt::format("an int() or der() of `{}` in `{}`", s.signal, print(s.derivative));
+        const double sigma = noise[r].at(s.signal);
+        auto& sum = curvature[{s.column, s.order}];
+        sum = ir::add(sum, ir::scale(*twice, Number::real(sigma * sigma / 2)));
+      }
+      for (const auto& [where, sum] : curvature) {
+        if (sum.terms.empty()) continue;
+        auto values = evaluators[r].evaluate_in_window(sum, "the curvature of the rows");
+        if (auto* d = std::get_if<Diagnostic>(&values)) return d->message;
+        const auto& v = std::get<std::vector<double>>(values);
+        const std::vector<double> w = test_function_weights(grid, where.second, evaluators[r].record().step);
+        for (Eigen::Index j = 0; j < K; ++j) {
+          const double value = support_dot(w, v.data() + (grid.centres[static_cast<std::size_t>(j)] - grid.half_width));
+          if (where.first) out.first(offset + j, static_cast<Eigen::Index>(*where.first)) += value;
+          else out.second(offset + j) += value;
         }
-        for (const auto& [k, terms] : by_order) {
-          const ir::Sum g = ir::canonical(terms);
-          ir::Sum curvature;
-          for (const auto& [signal, sigma] : noise[r]) {
-            if (!(sigma > 0)) continue;
-            auto once = partial_derivative(g, signal, 0);
-            auto twice = once ? partial_derivative(*once, signal, 0) : std::nullopt;
-            if (!twice) return fmt::format("an int() or der() of `{}` in `{}`", signal, print(g));
-            curvature = ir::add(curvature, ir::scale(*twice, Number::real(sigma * sigma / 2)));
-          }
-          if (curvature.terms.empty()) continue;
-          auto values = evaluators[r].evaluate_in_window(curvature, "the curvature of the rows");
-          if (auto* d = std::get_if<Diagnostic>(&values)) return d->message;
-          const auto& v = std::get<std::vector<double>>(values);
-          const std::vector<double> w = test_function_weights(grid, k, evaluators[r].record().step);
-          for (Eigen::Index j = 0; j < K; ++j) {
-            const double value = support_dot(w, v.data() + (grid.centres[static_cast<std::size_t>(j)] - grid.half_width));
-            if (column) out.first(offset + j, static_cast<Eigen::Index>(*column)) += value;
-            else out.second(offset + j) += value;
-          }
-        }
-        return std::nullopt;
-      };
-      for (const auto& term : eq.terms)
-        if (auto why = add(term.operation, design.column(term.parameter, r))) return *why;
-      if (auto why = add(eq.known, std::nullopt)) return *why;
+      }
       offset += K;
     }
   }
@@ -331,7 +320,7 @@ std::pair<LeastSquaresSummary, WeakWeighting> weight_weak_rows(
   // cubic: E (y + e)^3 = y^3 + 3 sigma^2 y), is taken out of the rows with the noise variances the
   // weighted residuals calibrate (their variance times each signal's estimated one). Where there is
   // one, a first weighted solve calibrates and the corrected rows are iterated until they settle.
-  auto shift = mean_shift(model, design, equations, evaluators, weak.grids, noise);
+  auto shift = mean_shift(parts, design, evaluators, weak.grids, noise);
   if (auto* why = std::get_if<std::string>(&shift)) return keep(*why);
   const auto& [dA, db] = std::get<std::pair<Eigen::MatrixXd, Eigen::VectorXd>>(shift);
   const bool shifted = dA.any() || db.any();  // any(): some entry is not zero

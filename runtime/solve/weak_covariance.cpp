@@ -43,13 +43,7 @@ std::variant<std::vector<Sensitivity>, std::string> sensitivities(const ir::Mode
   std::vector<Sensitivity> out;
   // Adds one sum's sensitivities; says why when there is none to write.
   const auto add = [&](const ir::Sum& sum, std::optional<std::size_t> column) -> std::optional<std::string> {
-    std::map<int, std::vector<ir::Term>> parts;  // g_k by the order of phi_j^(k)
-    for (const auto& t : sum.terms) {
-      auto [k, rest] = split_test_function(t);
-      parts[k].push_back(ir::canonical(rest));
-    }
-    for (const auto& [k, terms] : parts) {
-      const ir::Sum g = ir::canonical(terms);
+    for (const auto& [k, g] : parts_by_test_function(sum)) {
       for (const auto& level : noise) {
         const std::string& signal = level.first;  // named, not bound: lambdas below capture it
         if (!(level.second > 0)) continue;

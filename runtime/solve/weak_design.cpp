@@ -39,8 +39,8 @@ std::set<std::string> outputs_used(const ir::Model& model, const DesignBuilder& 
 
 ir::Sum signal_sum(const std::string& name) { return ir::factor(ir::Factor{ir::FactorKind::signal, name, 0, {}, {}, {}, {}}); }
 
-}  // namespace
-
+// The order of a term's test function and the term without it (weak_pass puts exactly one, to the
+// power 1, on every term; the compiled-model reader checks files for the same).
 std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
   ir::Term rest = t;
   int order = 0;
@@ -50,6 +50,19 @@ std::pair<int, ir::Term> split_test_function(const ir::Term& t) {
     rest.factors.erase(it);
   }
   return {order, rest};
+}
+
+}  // namespace
+
+std::map<int, ir::Sum> parts_by_test_function(const ir::Sum& s) {
+  std::map<int, std::vector<ir::Term>> terms;
+  for (const auto& t : s.terms) {
+    auto [k, rest] = split_test_function(t);
+    terms[k].push_back(ir::canonical(rest));
+  }
+  std::map<int, ir::Sum> out;
+  for (auto& [k, part] : terms) out[k] = ir::canonical(std::move(part));
+  return out;
 }
 
 // sum_i a[i] * b[i] in four running sums, added pairwise at the end: one sum would wait on each
@@ -129,24 +142,19 @@ std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::stri
 }
 
 std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, const std::string& what, std::span<double> out) {
-  std::map<int, std::vector<ir::Term>> parts;  // g_k by the order k of phi_j^(k)
-  for (const auto& t : sum.terms) {
-    auto [k, rest] = split_test_function(t);
-    parts[k].push_back(ir::canonical(rest));
-  }
   std::fill(out.begin(), out.end(), 0.0);
   const std::size_t m = grid_.half_width;
-  for (const auto& [k, terms] : parts) {
+  for (const auto& [k, g_k] : parts_by_test_function(sum)) {
     if (weights_.size() <= static_cast<std::size_t>(k)) weights_.resize(static_cast<std::size_t>(k) + 1);
     auto& w = weights_[static_cast<std::size_t>(k)];
     if (w.empty()) w = test_function_weights(grid_, k, evaluator_.record().step);
     if (!evaluator_.segmented()) {
-      if (auto problem = add_rows(ir::canonical(terms), what, w, out)) return problem;
+      if (auto problem = add_rows(g_k, what, w, out)) return problem;
       continue;
     }
     // Held or linear inputs: int phi^(k) g interval by interval within the inputs' segments, g read
     // on its pieces (runtime/operators/piecewise_inputs.hpp); phi^(k) vanishes outside the support.
-    auto stencil = evaluator_.stencil_values(ir::canonical(terms), &what);
+    auto stencil = evaluator_.stencil_values(g_k, &what);
     if (auto* d = std::get_if<Diagnostic>(&stencil)) return *d;
     const Evaluator::Stencil& g = std::get<Evaluator::Stencil>(stencil);  // g[o][a]: window sample a as interval a - d sees it
     const IntervalRules rules(0);

@@ -12,6 +12,7 @@
 // block by block (memory of a block, not of the record; held or linear inputs: on the whole window).
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,9 +31,8 @@ namespace sidc {
 // rows would not be commensurable: samples against subdomains).
 std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::vector<std::size_t>& equations);
 
-// The order k of a weak term's test function phi_j^(k) and the term without it (weak_pass puts
-// exactly one, to the power 1, on every term; the compiled-model reader checks files for the same).
-std::pair<int, ir::Term> split_test_function(const ir::Term& t);
+// A weak operation sum_k phi_j^(k) * g_k as its parts g_k, by the order k of the test function.
+std::map<int, ir::Sum> parts_by_test_function(const ir::Sum& s);
 
 // sum_i a[i] * b[i] over n values, summed in a fixed order (the same result on every run and thread).
 double running_dot(const double* a, const double* b, std::size_t n);

@@ -10,6 +10,9 @@ For every system of systems.py, noise level and seed, and every configuration, i
      record: the truth about whether the fitted model "follows" (fit % >= 90 for every output,
      the threshold sidc's own verdict uses), which the verdict should agree with;
   3. `sidc select library.sid --out sel`: is the chosen subset exactly the true term set?
+  4. with --bound, `sidc fit truth_model.sid --refine`: the output error's Gauss-Newton standard
+     errors, the Cramer-Rao bound of the record (what no unbiased estimator beats; see
+     bound_of below), so that an error target can be told apart from one the record cannot meet.
 
 and prints one Markdown table per configuration, and writes every run to results.csv and
 results.json. A failing sidc (non-zero exit, timeout, missing output) is recorded as such and the
@@ -127,7 +130,28 @@ def max_relative_error(estimates, truth):
     return errors[worst], worst
 
 
-def run_case(sidc, work, config, system, level, seed, timeout):
+def bound_of(sidc, d, system, timeout):
+    """The record's Cramer-Rao bound: sd_k / |a_k| for each true parameter, from the Gauss-Newton
+    covariance of the output-error refinement of the true terms (`sidc fit --refine`: the inverse
+    Fisher information of white Gaussian output noise, with the noise variance and the initial
+    state estimated, evaluated at the refined values). The bench's noise is exactly that kind, so
+    no unbiased estimator of the same record has a smaller standard deviation (to first order).
+    None when the refinement fails or gives no standard error."""
+    rc, _, secs = run([sidc, "fit", "truth_model.sid", "--refine", "--no-validate", "--refine-samples", "0",
+                       "--out", "bound"], d, timeout)
+    path = os.path.join(d, "bound", "fit.json")
+    if rc != 0 or not os.path.exists(path):
+        return None, secs
+    refinement = json.load(open(path)).get("refinement") or {}
+    if refinement.get("status") == "failed":
+        return None, secs
+    se = {p["name"]: p.get("standard_error") for p in refinement.get("parameters", [])}
+    if any(se.get(k) is None or not math.isfinite(se[k]) for k in system.truth):
+        return None, secs
+    return {k: se[k] / abs(v) for k, v in system.truth.items()}, secs
+
+
+def run_case(sidc, work, config, system, level, seed, timeout, bound=False):
     d = os.path.join(work, config.name, system.name, f"noise{level:g}_s{seed}")
     truth = records.write_case(d, system, level, seed)
     base_model = open(os.path.join(d, "model.sid")).read()
@@ -145,7 +169,7 @@ def run_case(sidc, work, config, system, level, seed, timeout):
            "truth_fit_percent": None, "truth_follows": None, "verdict_agrees": None,
            "select_exit": None, "select_error": "", "selected": None, "select_recovered": None,
            "seconds": 0.0, "equation_error_max_rel_error": None, "iv_termination": None, "iv_iterations": None,
-           "refined": None, "covered": None, "intervals": None, "covered_hac": None}
+           "refined": None, "covered": None, "intervals": None, "covered_hac": None, "bound": None, "bound_parameter": None}
 
     # 1. the fit of the true terms
     rc, err, secs = run([sidc, "fit", "model.sid", "--out", "fit"] + config.fit_options, d, timeout)
@@ -232,6 +256,14 @@ def run_case(sidc, work, config, system, level, seed, timeout):
         row["select_recovered"] = chosen == true_set
     else:
         row["select_error"] = err or "select.json missing"
+
+    # 4. the record's Cramer-Rao bound (noisy records only: noise 0 has none)
+    if bound and level > 0:
+        relative_sd, s4 = bound_of(sidc, d, system, timeout)
+        row["seconds"] += s4
+        if relative_sd:
+            row["bound_parameter"] = max(relative_sd, key=relative_sd.get)
+            row["bound"] = relative_sd[row["bound_parameter"]]
     return row
 
 
@@ -345,6 +377,9 @@ def tables(rows, configs, systems, levels):
                    f"{met15} of {cells15} system x noise cells. The 95% intervals held the truth for {held} of {judged} "
                    f"parameters on the noisy records" + (f" ({100 * held / judged:.0f}%, target 90-100%)" if judged else "") + ".")
         out.append("")
+    bounded = [r for r in rows if r.get("bound") is not None]
+    if bounded:
+        out += bound_table(rows, configs, systems, [lv for lv in levels if lv > 0])
     if len({r["config"] for r in rows}) > 1:
         out.append("### Best configuration per case (chosen knowing the truth: what is reachable)")
         out.append("")
@@ -368,10 +403,49 @@ def tables(rows, configs, systems, levels):
     return "\n".join(out)
 
 
+def bound_table(rows, configs, systems, levels):
+    """The Cramer-Rao table (--bound): per system and noise, the bound on the worst-determined
+    parameter (median over seeds), the default's error in units of it, and the error targets that
+    lie below it, which no unbiased estimator meets on most seeds (|z| <= 1 has probability 0.68
+    for one seed, 0.68^3 = 0.31 for three)."""
+    first = configs[0].name
+    out = ["### The records' Cramer-Rao bound (`--bound`)", "",
+           "Largest relative standard deviation any unbiased estimator can reach on the record (the output error's "
+           "inverse Fisher information, `sidc fit --refine` of the true terms), median over seeds, with the parameter; "
+           f"then the largest error of configuration `{first}` in units of that bound (median over seeds).", "",
+           "| system | " + " | ".join(f"noise {100 * lv:g}%" for lv in levels) + " |",
+           "| --- |" + " ---: |" * len(levels)]
+    below = []
+    for s in systems:
+        cells = []
+        for lv in levels:
+            rs = [r for r in rows if r["config"] == first and r["system"] == s.name and r["noise"] == lv]
+            bs = [r for r in rs if r.get("bound") is not None]
+            if not bs:
+                cells.append("-")
+                continue
+            b = statistics.median(r["bound"] for r in bs)
+            worst = max(bs, key=lambda r: r["bound"])["bound_parameter"]
+            ratios = [r["max_rel_error"] / r["bound"] for r in bs if r.get("max_rel_error") is not None]
+            cells.append(f"{pct(b)} `{worst}`" + (f"<br>error {statistics.median(ratios):.2g} x" if ratios else ""))
+            targets = []
+            if s.issue13 and lv in TARGETS:
+                targets.append(("13", TARGETS[lv] if s.smooth else NON_SMOOTH_TARGET))
+            if lv in TARGETS_15:
+                targets.append(("15", TARGETS_15[lv][0 if s.smooth else 1]))
+            below += [f"{s.name} at {100 * lv:g}% (issue {i}: {pct(t)}, bound {pct(b)})" for i, t in targets if t < b]
+        out.append(f"| {s.name} | " + " | ".join(cells) + " |")
+    out.append("")
+    out.append(f"Error targets below the bound ({len(below)}): " + ("; ".join(below) if below else "none") + ".")
+    out.append("")
+    return out
+
+
 CSV_FIELDS = ["config", "system", "noise", "seed", "fit_exit", "max_rel_error", "worst_parameter", "verdict",
               "validation_fit_percent", "truth_fit_percent", "truth_follows", "verdict_agrees", "select_exit",
               "selected", "select_recovered", "seconds", "fit_error", "select_error", "estimates",
-              "equation_error_max_rel_error", "iv_termination", "iv_iterations", "refined", "covered", "intervals", "covered_hac"]
+              "equation_error_max_rel_error", "iv_termination", "iv_iterations", "refined", "covered", "intervals", "covered_hac",
+              "bound", "bound_parameter"]
 
 
 def write_results(out_dir, rows, markdown):
@@ -408,6 +482,8 @@ def main():
     p.add_argument("--sensitivity", action="store_true",
                    help="only print how strict 'follows' is: fit %% of the truth with one parameter off by 0.1%% or 1%%")
     p.add_argument("--timeout", type=float, default=600, help="seconds per sidc command (default 600)")
+    p.add_argument("--bound", action="store_true",
+                   help="also compute each noisy record's Cramer-Rao bound (sidc fit --refine of the true terms) and tabulate it")
     a = p.parse_args()
 
     sidc = os.path.abspath(a.sidc)
@@ -440,7 +516,7 @@ def main():
     rows = []
     start = time.monotonic()
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = {pool.submit(run_case, sidc, a.work, c, s, lv, k, a.timeout): (c, s, lv, k) for c, s, lv, k in jobs}
+        futures = {pool.submit(run_case, sidc, a.work, c, s, lv, k, a.timeout, a.bound and c is configs[0]): (c, s, lv, k) for c, s, lv, k in jobs}
         for fut in concurrent.futures.as_completed(futures):
             c, s, lv, k = futures[fut]
             try:

@@ -12,6 +12,7 @@
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/operators/piecewise_inputs.hpp"
 #include "runtime/parallel_ranges.hpp"
+#include "runtime/solve/switch_quadrature.hpp"
 
 namespace sidc {
 namespace {
@@ -150,6 +151,7 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
     if (w.empty()) w = test_function_weights(grid_, k, evaluator_.record().step);
     if (!evaluator_.segmented()) {
       if (auto problem = add_rows(g_k, what, w, out)) return problem;
+      if (auto problem = add_switch_corrections(evaluator_, grid_, g_k, w, out)) return problem;
       continue;
     }
     // Held or linear inputs: int phi^(k) g interval by interval within the inputs' segments, g read

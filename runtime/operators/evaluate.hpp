@@ -124,14 +124,14 @@ class Evaluator {
   // whole record is 80 MB at 10^7 samples: copying each factor of each term dominated weak forms.
   std::variant<std::span<const double>, Diagnostic> factor_view(const ir::Factor& f, const Span& where, Values& scratch);
   std::variant<Values, Diagnostic> signal(const std::string& name, int order, const Span& where);
-  std::variant<const Values*, Diagnostic> signal_view(const std::string& name, int order, const Span& where);
+  std::variant<std::span<const double>, Diagnostic> signal_view(const std::string& name, int order, const Span& where);
   std::variant<double, Diagnostic> initial_value(const ir::Factor& f, const Span& where);
 
   const SampledRecord& record_;
   const ir::Model& model_;
   EvaluationOptions options_;
   FitWindow window_;
-  std::map<std::pair<std::string, int>, Values> derivatives_;  // (signal, order) -> values
+  std::map<std::pair<std::string, int>, Values> derivatives_;  // (signal, order >= 1) -> values
   std::map<std::string, Values> composite_;                    // integrals and der() by printed text
   bool segmented_ = false;
   std::vector<unsigned char> boundaries_;  // piece_boundaries(), made on first use

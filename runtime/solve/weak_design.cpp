@@ -1,6 +1,8 @@
 #include "runtime/solve/weak_design.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <list>
 #include <map>
 #include <mutex>
 #include <set>
@@ -186,14 +188,25 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
   WeakDesign out;
   std::variant<TestFunctionGrid, Diagnostic> chosen = Diagnostic{};
   {
-    // The outputs on the window, only while the width is chosen (80 MB each at 10^7 samples).
-    std::vector<std::vector<double>> values;
+    // The outputs on the window, read where the record holds them (a copy is 80 MB each at 10^7
+    // samples); an output the record lacks, or with a value that is not finite, is evaluated for
+    // the evaluator's message.
+    const FitWindow& fit_window = evaluator.window();
+    std::vector<std::span<const double>> spans;
+    std::list<std::vector<double>> evaluated;
     for (const auto& name : outputs_used(model, design)) {
+      const auto found = records[r].signals.find(name);
+      if (found != records[r].signals.end() && fit_window.first + fit_window.size() <= found->second.size()) {
+        const auto v = std::span<const double>(found->second).subspan(fit_window.first, fit_window.size());
+        if (std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); })) {
+          spans.push_back(v);
+          continue;
+        }
+      }
       auto v = evaluator.evaluate_in_window(signal_sum(name), "the output `" + name + "`");
       if (auto* d = std::get_if<Diagnostic>(&v)) return *d;
-      values.push_back(std::get<std::vector<double>>(std::move(v)));
+      spans.push_back(evaluated.emplace_back(std::get<std::vector<double>>(std::move(v))));
     }
-    const std::vector<std::span<const double>> spans(values.begin(), values.end());
     const std::size_t fewest_rows = std::max<std::size_t>(20, 4 * design.columns().size());
     chosen = choose_test_functions(spans, evaluator.window().size(), records[r].step, highest_test_function_order(design), fewest_rows,
                                    records[r].path);

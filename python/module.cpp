@@ -520,7 +520,7 @@ py::tuple run_simulate(const ModelHandle& m, const py::dict& params, const py::o
   if (auto* f = std::get_if<Failure>(&result)) raise(std::move(*f));
   auto& summary = std::get<SimulationSummary>(result);
   py::dict out;
-  out["t"] = numpy_owning(std::move(summary.time));
+  out["t"] = numpy_owning(std::move(summary.time).release());
   for (std::size_t i = 0; i < summary.output_names.size(); ++i) out[py::str(summary.output_names[i])] = numpy_owning(std::move(summary.outputs[i]));
   const std::string stopped = summary.completed() ? std::string() : render(cli_diag::simulation_stopped(summary.message));
   return py::make_tuple(out, summary.brief_report(), stopped);

@@ -154,8 +154,8 @@ std::vector<NamedFigure> fit_figures(const PictureContext& c) {
     const ValidationSummary& run = c.validations[v];
     for (std::size_t o = 0; o < run.outputs.size(); ++o) {
       const SignalLabel output{run.outputs[o].output, unit_of(run.outputs[o].output)};
-      Figure a = recorded_vs_simulated_figure(time, output, run.simulation.time, run.recorded[o], run.simulation.outputs[o]);
-      Figure b = simulation_error_figure(time, output, run.simulation.time, run.recorded[o], run.simulation.outputs[o]);
+      Figure a = recorded_vs_simulated_figure(time, output, run.simulation.time.to_vector(), run.recorded[o].to_vector(), run.simulation.outputs[o]);
+      Figure b = simulation_error_figure(time, output, run.simulation.time.to_vector(), run.recorded[o].to_vector(), run.simulation.outputs[o]);
       const std::string s = c.validations.size() > 1 ? fmt::format("_r{}", v + 1) : std::string();
       a.name += s, b.name += s;
       // Which record: with several, `_r2` alone does not say; a held-out one is the test on new data.

@@ -17,7 +17,7 @@ constexpr int kMaxDampingTries = 12;  // lambda grows tenfold per rejected trial
 // The segment's least-squares problem: the state as a vector, its residuals by a free run.
 class StartProblem {
  public:
-  StartProblem(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& whole, const std::vector<std::vector<double>>& recorded,
+  StartProblem(const ir::Model& model, const ExplicitForm& form, const SimulateOptions& whole, const std::vector<Column>& recorded,
                std::size_t segment)
       : model_(model), form_(form), options_(whole.first_samples(segment)), recorded_(recorded), segment_(segment) {
     const double duration = options_.time.back() - options_.time.front();
@@ -66,7 +66,7 @@ class StartProblem {
   const ir::Model& model_;
   const ExplicitForm& form_;
   SimulateOptions options_;
-  const std::vector<std::vector<double>>& recorded_;
+  const std::vector<Column>& recorded_;
   std::size_t segment_;
   std::vector<double> scale_, typical_;
 };
@@ -74,7 +74,7 @@ class StartProblem {
 }  // namespace
 
 InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options,
-                                            const std::vector<std::vector<double>>& recorded, std::size_t segment) {
+                                            const std::vector<Column>& recorded, std::size_t segment) {
   InitialStateEstimate out;
   out.initial = options.initial;
   segment = std::clamp<std::size_t>(segment, 2, options.time.size());

@@ -34,6 +34,6 @@ struct InitialStateEstimate {
 // per output of `form` the recorded values on options.time. Only the first `segment` samples
 // (at least 2) are simulated.
 InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& options,
-                                            const std::vector<std::vector<double>>& recorded, std::size_t segment);
+                                            const std::vector<Column>& recorded, std::size_t segment);
 
 }  // namespace sidc

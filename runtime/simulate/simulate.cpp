@@ -32,7 +32,7 @@ using Weighted = WeightedPointSum;
 // the ends of the grid. Exact for cubics, so the interpolation error is O(h^4), RK4's order.
 // `hint`: the sample interval of the last call, tried with the next one before a binary search
 // (steppers move forward), and set to the interval found.
-double interpolate_cubic(const std::vector<double>& time, const std::vector<double>& v, double t, std::size_t& hint) {
+double interpolate_cubic(std::span<const double> time, std::span<const double> v, double t, std::size_t& hint) {
   const std::size_t n = time.size();
   if (n == 1) return v[0];
   auto inside = [&](std::size_t k) { return k + 1 < n && time[k] <= t && t < time[k + 1]; };
@@ -473,9 +473,9 @@ class System {
     ir::Signal::Hold hold = ir::Signal::Hold::smooth;  // of a column
     std::size_t slot = 0, index = 0;
     PointSum definition;
-    const std::vector<double>* column = nullptr;  // a recorded input's samples, in the options
+    const Column* column = nullptr;  // a recorded input's samples, in the options
     std::vector<double> owned;                    // or its estimated derivative
-    const std::vector<double>& values() const { return column ? *column : owned; }
+    std::span<const double> values() const { return column ? std::span<const double>(*column) : std::span<const double>(owned); }
     // The last value read and where: RK4's two middle stages read the same instant.
     mutable double last_t = std::numeric_limits<double>::quiet_NaN(), last_value = 0;
     mutable std::size_t last_interval = 0;
@@ -483,10 +483,10 @@ class System {
   };
   // A recorded input at t, within the current interval for a held or linear one.
   double recorded(const Source& s, double t) const {
-    const std::vector<double>& time = options_->time;
+    const Column& time = options_->time;
     const std::size_t k = interval_;
     if (t == s.last_t && k == s.last_interval) return s.last_value;
-    const std::vector<double>& v = s.values();
+    const std::span<const double> v = s.values();
     double value = kNaN;
     switch (s.hold) {
       case ir::Signal::Hold::smooth: value = interpolate_cubic(time, v, t, s.hint); break;
@@ -594,7 +594,7 @@ SimulateOptions SimulateOptions::samples(std::size_t first, std::size_t last) co
   out.parameters = parameters;
   out.initial = initial;
   const std::size_t end = std::min(last, time.size()), begin = std::min(first, end);
-  const auto cut = [&](const std::vector<double>& values) {
+  const auto cut = [&](std::span<const double> values) {
     const std::size_t b = std::min(begin, values.size()), e = std::min(end, values.size());
     return std::vector<double>(values.begin() + static_cast<std::ptrdiff_t>(b), values.begin() + static_cast<std::ptrdiff_t>(e));
   };
@@ -638,7 +638,8 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
     summary.outputs = std::move(outputs);
     summary.sensitivity = std::move(sensitivity);
   }
-  summary.time.assign(o.time.begin(), o.time.end());
+  if (o.time.is_borrowed()) summary.time = o.time;  // the record's samples, shared
+  else summary.time.owned().assign(o.time.begin(), o.time.end());
   const std::size_t n = o.time.size();
   summary.outputs.resize(form.outputs.size());
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {

@@ -33,6 +33,7 @@
 
 #include "ir/explicit_form.hpp"
 #include "runtime/operators/evaluate.hpp"
+#include "runtime/records/column.hpp"
 
 namespace sidc {
 
@@ -49,9 +50,11 @@ struct SimulateOptions {
   std::vector<double> parameters;  // by index into the normalized model's parameters
   // Initial state per output: y(t0), y'(t0), ..., y^(n-1)(t0) (n values, the output's order).
   std::map<std::string, std::vector<double>> initial;
-  std::vector<double> time;  // the output grid, increasing, time[0] = t0; uniform not required
-  // Inputs without a definition: samples on `time` (a record's columns).
-  std::map<std::string, std::vector<double>> inputs;
+  // The output grid, increasing, time[0] = t0; uniform not required. A Column, so that a record's
+  // own samples are simulated against where they lie (a copy is 80 MB at 10^7 samples).
+  Column time;
+  // Inputs without a definition: samples on `time` (a record's columns, borrowed the same way).
+  std::map<std::string, Column> inputs;
   double t0_for_tau = 0;  // the window start `t0` (and tau = t - t0) as the model means it; usually time[0]
   // The value of an initial-value factor such as `y2(0)` (eq. 4-2.4's constants=initial form);
   // unset, or nullopt from it: the model cannot be simulated (a Diagnostic at the term).
@@ -86,7 +89,7 @@ struct SimulationSummary {
   std::size_t steps = 0;               // accepted steps (rk4: including partial steps at switches)
   std::size_t switches = 0;            // guard switches located (rk4)
   std::size_t right_hand_sides = 0;    // evaluations of the equations
-  std::vector<double> time;
+  Column time;  // the options' grid: shared with them when they borrow a record's samples
   std::vector<std::string> output_names;
   std::vector<std::vector<double>> outputs;  // per output, on `time`; NaN after stopped_at
   // With SimulateOptions::sensitivities: per output, row-major [row * sensitivity_columns + q], d y / d q

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <fmt/format.h>
 
 #include "runtime/simulate/initial_state.hpp"
@@ -29,7 +30,7 @@ constexpr double kNotFinite = -1;  // a square's place when the error is not fin
 // Each square is taken once (a whole record has millions of samples, each in 11 windows), kept in
 // a ring of the window's length, and the window's squares are added in sample order, as a sum
 // over the window taken afresh would.
-std::optional<double> departure(const std::vector<double>& y, const std::vector<double>& yhat, const std::vector<double>& time, double limit) {
+std::optional<double> departure(std::span<const double> y, std::span<const double> yhat, std::span<const double> time, double limit) {
   const std::size_t n = y.size(), w = kDepartureHalfWidth, length = 2 * w + 1;
   std::array<double, 2 * kDepartureHalfWidth + 1> ring;  // squares[k] at k % length; kNotFinite where e[k] is not finite
   auto square = [&](std::size_t k) {
@@ -98,7 +99,13 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   if (start + 1 >= record.time.size()) start = 0;
   const auto from = static_cast<std::ptrdiff_t>(start);
   const auto to = static_cast<std::ptrdiff_t>(options.max_samples > 0 ? std::min(record.time.size(), start + options.max_samples) : record.time.size());
-  o.time.assign(record.time.begin() + from, record.time.begin() + to);
+  // The record's own samples, borrowed, not copied (80 MB a column at 10^7 samples): the record
+  // outlives the run, as options.initial_value's reading of it already requires.
+  const std::shared_ptr<const void> record_alive(std::shared_ptr<const void>{}, &record);
+  const auto on_grid = [&](const Column& column) {
+    return Column::borrowed(std::span<const double>(column).subspan(static_cast<std::size_t>(from), static_cast<std::size_t>(to - from)), record_alive);
+  };
+  o.time = on_grid(record.time);
   o.t0_for_tau = record.time.front();
   // `y(0)`, `y(t0)`, `y(2.5)`: a recorded output's value, as the fit read it (eq. 4-2.4). Derivatives
   // at a point would need the moving arc there; none of the thesis' models uses one.
@@ -113,16 +120,13 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   };
   for (const auto& s : normalized.signals)
     if (s.kind == ir::Signal::Kind::input && !s.definition)
-      if (auto it = record.signals.find(s.name); it != record.signals.end()) o.inputs[s.name].assign(it->second.begin() + from, it->second.begin() + to);
+      if (auto it = record.signals.find(s.name); it != record.signals.end()) o.inputs[s.name] = on_grid(it->second);
   auto initial = initial_state_from_record(form, record, std::get<EvaluationOptions>(chosen), start, true);
   if (auto* d = std::get_if<Diagnostic>(&initial)) return *d;
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
   run.start = start;
   run.truncated = static_cast<std::size_t>(to) < record.time.size();
-  for (const auto& out : form.outputs) {
-    const auto& column = record.signals.at(out.name);
-    run.recorded.emplace_back(column.begin() + from, column.begin() + to);
-  }
+  for (const auto& out : form.outputs) run.recorded.push_back(on_grid(record.signals.at(out.name)));
   return run;
 }
 
@@ -132,7 +136,7 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
   RecordRun& prepared_run = std::get<RecordRun>(prepared);
   SimulateOptions& o = prepared_run.options;
-  const std::vector<std::vector<double>>& recorded = prepared_run.recorded;  // per output, on o.time
+  const std::vector<Column>& recorded = prepared_run.recorded;  // per output, on o.time
 
   ValidationSummary v;
   v.record = record.path;
@@ -155,7 +159,7 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   v.simulation = std::get<SimulationSummary>(std::move(run));
 
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {
-    const std::vector<double>& y = recorded[j];
+    const Column& y = recorded[j];
     const std::vector<double>& yhat = v.simulation.outputs[j];
     OutputValidation r;
     r.output = form.outputs[j].name;

@@ -118,7 +118,7 @@ struct ValidationSummary {
   std::vector<OutputValidation> outputs;
   // Per output, on simulation.time: the record (the solution is simulation.outputs, the error
   // E = recorded - simulated, eq. 4-1.4, not held: 8 bytes a sample less).
-  std::vector<std::vector<double>> recorded;
+  std::vector<Column> recorded;  // borrowed from the record
   std::string statement;  // one plain sentence: how well, or where it diverged
   bool truncated = false;  // ValidationOptions::max_samples stopped it before the record's end
   std::string report(const std::string& method) const;
@@ -133,7 +133,7 @@ std::vector<std::pair<std::string, double>> named_state(const ExplicitForm& form
 // recorded outputs on that grid, and the moving-arc initial state in options.initial.
 struct RecordRun {
   SimulateOptions options;                    // method and steps from the ValidationOptions; `parameters` set
-  std::vector<std::vector<double>> recorded;  // per output of the form, on options.time
+  std::vector<Column> recorded;               // per output of the form, on options.time (borrowed from the record)
   std::size_t start = 0;                      // the record's sample at options.time[0]
   bool truncated = false;                     // max_samples stopped the grid before the record's end
 };

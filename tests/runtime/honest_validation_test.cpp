@@ -137,7 +137,7 @@ TEST(Verdict, SaysWhereAWrongModelDepartsAndByHowMuch) {
   EXPECT_LT(*y.departs_at, y.time_of_max);
   EXPECT_GT(y.max_abs_error, 0.5);
   {  // where it departs, as the definition says: the first local RMS error (11 samples) above a tenth of y's spread
-    const std::vector<double>& recorded = bad.recorded[0];
+    const Column& recorded = bad.recorded[0];
     std::vector<double> e(recorded.size());
     for (std::size_t i = 0; i < e.size(); ++i) e[i] = recorded[i] - bad.simulation.outputs[0][i];
     double mean = 0, squares = 0;

@@ -131,7 +131,8 @@ void nelder_mead(Objective& f, std::vector<double>& best, double& best_value, co
 }
 
 // The first nonlinear parameter that stands in a guard or in sign() (a threshold, `[y > y0]`): G
-// changes in steps as the threshold passes samples, so it has no curvature to take there.
+// changes in steps as the threshold passes samples (in the weak form, whose switches are located
+// between the samples, its slope does), so it has no curvature to take there.
 const ir::Parameter* threshold(const ir::Model& model) {
   const ir::Parameter* found = nullptr;
   const auto visit = [&](const ir::Factor& f, const ir::Term&) {
@@ -257,7 +258,7 @@ NonlinearIntervals nonlinear_intervals(const ir::Model& model, const std::vector
     return out;
   }
   if (const ir::Parameter* p = threshold(model)) {
-    out.note = fmt::format("`{}` is a threshold (in a guard or sign()), where G changes in steps as it passes the samples", p->name);
+    out.note = fmt::format("`{}` is a threshold (in a guard or sign()), where G, or in the weak form its slope, changes in steps as it passes the samples", p->name);
     return out;
   }
   const double G = total_G(summary);

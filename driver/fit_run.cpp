@@ -248,7 +248,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
 
   if (!a.no_validate) {
     // The fitted records, then those given only to be compared with (not copied: records can be long).
-    std::vector<SampledRecord> extra;
+    std::vector<SampledRecord>& extra = run.validated_only;
     for (auto& input : run.settings.validate) {
       auto record = load_record(model, std::move(input), run.loaded.bind);
       if (auto* d = std::get_if<Diagnostic>(&record)) return failure(*d);

@@ -92,6 +92,9 @@ struct FitRun {
   std::optional<InstrumentalVariablesSummary> instrumental_variables;
   std::optional<RefineSummary> refinement;
   std::optional<FitValidation> validation;
+  // The records given only to be compared with (--validate): kept as long as `validation`, whose
+  // recorded outputs and grids borrow their columns.
+  std::vector<SampledRecord> validated_only;
   ResidualAnalysis residuals;
   std::optional<LocalFitSummary> local;
 };

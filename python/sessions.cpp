@@ -135,7 +135,7 @@ std::variant<SimulationSummary, Failure> simulate_session(const LoadedModel& loa
   for (const auto& s : model.signals)
     if (s.kind == ir::Signal::Kind::input && !s.definition && !a.inputs.count(s.name)) return failure(cli_diag::input_without_values(s.name));
   o.time = std::move(a.time);
-  for (auto& [name, values] : a.inputs) o.inputs[name] = std::move(values);
+  for (auto& [name, samples] : a.inputs) o.inputs[name] = std::move(samples);
   if (!o.time.empty()) o.t0_for_tau = o.time.front();
   if (std::string why; !o.is_valid(&why)) return failure(cli_diag::invalid_options(why));
   auto result = simulate(model, explicit_, o);

@@ -158,7 +158,7 @@ struct FitValidation {
 };
 
 // `records`: the fitted records first (`fitted_records` of them), then those given only to be
-// compared with. `form`: the compiled model's explicit form of `normalized`. `refined`: the
+// compared with; the runs borrow their columns (grids, recorded outputs), so they must outlive the result. `form`: the compiled model's explicit form of `normalized`. `refined`: the
 // parameters (by the normalized model's parameter) to solve with instead of the fit's, and
 // `refined_by` how they were had ("refined by the output error", "of instrumental variables").
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,

@@ -237,7 +237,8 @@ nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis) {
     for (const auto& c : rc.cross) cross.push_back(curve(c));
     groups.push_back({{"computed", true}, {"rows_used", truncated ? ordered_json(kMaxResidualRows) : ordered_json("all")}, {"n", rc.n}, {"segments", rc.segments}, {"max_lag", rc.max_lag},
                       {"confidence_level", rc.confidence_level}, {"band", rc.band}, {"residuals_white", rc.residuals_white},
-                      {"verdict", rc.verdict}, {"autocorrelation", curve(rc.autocorrelation)}, {"cross_correlation", cross}});
+                      {"verdict", rc.verdict}, {"autocorrelation", curve(rc.autocorrelation)}, {"cross_correlation", cross},
+                      {"intervals_to_trust", g < analysis.trust_newey_west.size() && analysis.trust_newey_west[g] ? "newey_west" : "classical"}});
   }
   return groups;
 }

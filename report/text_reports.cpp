@@ -1,6 +1,7 @@
 #include "report/text_reports.hpp"
 
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 
 #include "ir/queries.hpp"
@@ -75,7 +76,7 @@ std::string residual_report(const ResidualAnalysis& analysis) {
       out += fmt::format("\nresidual analysis{}: {}\n", group, analysis.notes[g]);
       continue;
     }
-    out += fmt::format("\n{}{}", group.empty() ? "" : fmt::format("equation group {}: ", g + 1), analysis.groups[g].brief_report());
+    out += fmt::format("\n{}{}", group.empty() ? "" : fmt::format("equation group {}: ", g + 1), analysis.groups[g].brief_report(g < analysis.hac_widening.size() ? analysis.hac_widening[g] : std::numeric_limits<double>::quiet_NaN()));
     if (g < analysis.truncated.size() && analysis.truncated[g])
       out += fmt::format("{}  (the first {} rows only)\n", out.back() == '\n' ? "" : "\n", kMaxResidualRows);
   }

@@ -641,12 +641,13 @@ std::string hac_report(const GroupFit& g) {
   // The weak form has its own note above; an unusable fit says so itself.
   if (!g.subdomains.empty() || !g.summary.is_solution_usable() || (!h.computed && h.note.empty())) return "";
   if (!h.computed) return fmt::format("  Newey-West (HAC) intervals: {}\n", h.note);
-  // One rule decides which intervals to trust, the residual analysis' whiteness verdict (its "for the
+  // One rule decides which intervals to trust, the residual analysis' (trust_newey_west: its "for the
   // intervals" line); this section gives the numbers it refers to.
   std::string out = fmt::format(
       "  Newey-West (HAC) intervals, which allow for autocorrelated rows (residual lag-1 autocorrelation {:.3g}, 99% band of\n"
-      "  independent rows +-{:.2g}): the ones to trust when the residual analysis below finds the residuals autocorrelated\n"
-      "  (scores prewhitened by an AR(1) each{}, Bartlett kernel of bandwidth {:.1f} rows by Andrews' plug-in)\n",
+      "  independent rows +-{:.2g}): the ones to trust when the residual analysis below finds the residuals autocorrelated,\n"
+      "  or when they are more than twice as wide as the classical ones (scores prewhitened by an AR(1) each{}, Bartlett\n"
+      "  kernel of bandwidth {:.1f} rows by Andrews' plug-in)\n",
       h.lag1_autocorrelation, h.band, h.prewhitening_clamped ? ", its coefficient capped at 0.97" : "", h.bandwidth);
   out += fmt::format("  {:<14} {:>15}   {:>31}   {}\n", "parameter", "HAC std. error", fmt::format("{:g}% confidence interval", 100 * h.level),
                      "x classical");

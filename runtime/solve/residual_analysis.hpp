@@ -21,6 +21,10 @@ struct ResidualAnalysis {
   std::vector<ResidualCorrelationSummary> groups;
   std::vector<std::string> notes;  // per group: why it was not computed ("" when it was)
   std::vector<bool> truncated;     // per group: only the first kMaxResidualRows rows were used
+  // Per group: the widest ratio of a Newey-West to a classical standard error (NaN where the fit has
+  // none), and whether the Newey-West intervals are the ones to trust (trust_newey_west).
+  std::vector<double> hac_widening;
+  std::vector<bool> trust_newey_west;
 };
 
 // The residuals of a long record are read as far as this many rows: the band is then +-0.0026,

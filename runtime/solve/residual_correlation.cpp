@@ -323,7 +323,11 @@ ResidualCorrelationSummary residual_correlation(const std::vector<std::vector<do
   return summary;
 }
 
-std::string ResidualCorrelationSummary::brief_report() const {
+bool trust_newey_west(const ResidualCorrelationSummary& residuals, double hac_widening) {
+  return residuals.is_usable() && (!residuals.autocorrelation.white || hac_widening > kHacWideningToTrust);
+}
+
+std::string ResidualCorrelationSummary::brief_report(double hac_widening) const {
   if (status != Status::success) return "residual analysis: " + message + "\n";
   std::string text = fmt::format(
       "residual analysis: {} residuals in {} segment(s), lags up to {}; correlations of mean-removed segments, "
@@ -333,10 +337,17 @@ std::string ResidualCorrelationSummary::brief_report() const {
   for (const auto& curve : cross) text += fmt::format("  cross-correlation with `{}`: {}\n", curve.name, curve.verdict);
   text += "  verdict: " + verdict + "\n";
   // What the whiteness verdict means for the fit's intervals (issue 15, item 4).
-  text += autocorrelation.white
-              ? "  for the intervals: the classical ones assume independent rows, and the residuals do not contradict it\n"
-              : "  for the intervals: the classical ones assume independent rows and are too narrow here; trust the Newey-West\n"
-                "  (HAC) ones where the fit report gives them (docs/accuracy.md, \"Intervals under autocorrelated rows\")\n";
+  if (!autocorrelation.white)
+    text += "  for the intervals: the classical ones assume independent rows and are too narrow here; trust the Newey-West\n"
+            "  (HAC) ones where the fit report gives them (docs/accuracy.md, \"Intervals under autocorrelated rows\")\n";
+  else if (trust_newey_west(*this, hac_widening))
+    text += fmt::format(
+        "  for the intervals: the residuals look white, but the Newey-West (HAC) ones are up to {:.3g} times as wide as the\n"
+        "  classical ones: the rows are correlated beyond what this test resolves at this length (an int() or a moving arc\n"
+        "  of a noisy signal carries each sample's noise into many rows); trust the Newey-West ones (docs/accuracy.md)\n",
+        hac_widening);
+  else
+    text += "  for the intervals: the classical ones assume independent rows, and the residuals do not contradict it\n";
   return text;
 }
 

@@ -1,6 +1,8 @@
 // runtime/solve/residual_correlation: white noise stays inside the 99% band at about the expected rate,
 // AR(1) residuals and a delayed input effect are detected at the right lags, records are never
 // correlated across their join, and short, constant or non-finite input comes back as a status.
+// Which intervals to trust: the classical ones for white residuals unless the fit's Newey-West ones
+// are more than twice as wide (kHacWideningToTrust), Newey-West's for autocorrelated residuals.
 //
 // Relies on: std::mt19937 with fixed seeds (deterministic with one standard library).
 #include "runtime/solve/residual_correlation.hpp"
@@ -8,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -67,6 +70,29 @@ TEST(ResidualCorrelation, Ar1ResidualsAreDetectedAtLagOne) {
   ASSERT_FALSE(summary.autocorrelation.lags_outside.empty());
   EXPECT_EQ(summary.autocorrelation.lags_outside.front(), 1);
   EXPECT_NE(summary.verdict.find("autocorrelated at lags 1"), std::string::npos) << summary.verdict;
+}
+
+TEST(ResidualCorrelation, SaysWhichIntervalsToTrust) {
+  const auto white = residual_correlation({white_noise(1000, 11)}, {}, {});
+  ASSERT_TRUE(white.is_usable() && white.autocorrelation.white) << white.message;
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(trust_newey_west(white, none));
+  EXPECT_FALSE(trust_newey_west(white, 1.5));
+  EXPECT_FALSE(trust_newey_west(white, kHacWideningToTrust));
+  EXPECT_TRUE(trust_newey_west(white, 3.0));
+  EXPECT_NE(white.brief_report(none).find("the residuals do not contradict it"), std::string::npos);
+  EXPECT_NE(white.brief_report(1.5).find("the residuals do not contradict it"), std::string::npos);
+  const std::string wide = white.brief_report(3.0);
+  EXPECT_NE(wide.find("the residuals look white, but the Newey-West (HAC) ones are up to 3 times as wide"), std::string::npos) << wide;
+  EXPECT_NE(wide.find("trust the Newey-West ones"), std::string::npos) << wide;
+  const auto noise = white_noise(1000, 7);
+  std::vector<double> e(noise.size());
+  e[0] = noise[0];
+  for (std::size_t t = 1; t < e.size(); ++t) e[t] = 0.5 * e[t - 1] + noise[t];
+  const auto correlated = residual_correlation({e}, {}, {});
+  ASSERT_TRUE(correlated.is_usable()) << correlated.message;
+  EXPECT_TRUE(trust_newey_west(correlated, none));
+  EXPECT_NE(correlated.brief_report(none).find("are too narrow here; trust the Newey-West"), std::string::npos);
 }
 
 TEST(ResidualCorrelation, LongRunsOfLagsAreListedAsRanges) {

@@ -26,6 +26,13 @@ std::vector<double> white_noise(std::size_t n, unsigned seed) {
   return out;
 }
 
+// e[t] = phi e[t-1] + white noise (phi = 1: a random walk).
+std::vector<double> autoregressive(double phi, std::size_t n, unsigned seed) {
+  std::vector<double> e = white_noise(n, seed);
+  for (std::size_t t = 1; t < e.size(); ++t) e[t] += phi * e[t - 1];
+  return e;
+}
+
 double value_at(const CorrelationCurve& curve, int lag) {
   for (std::size_t i = 0; i < curve.lags.size(); ++i)
     if (curve.lags[i] == lag) return curve.values[i];
@@ -57,10 +64,7 @@ TEST(ResidualCorrelation, WhiteNoiseStaysInsideTheBandAtTheExpectedRate) {
 }
 
 TEST(ResidualCorrelation, Ar1ResidualsAreDetectedAtLagOne) {
-  const auto noise = white_noise(1000, 7);
-  std::vector<double> e(noise.size());
-  e[0] = noise[0];
-  for (std::size_t t = 1; t < e.size(); ++t) e[t] = 0.5 * e[t - 1] + noise[t];
+  const auto e = autoregressive(0.5, 1000, 7);
   const auto summary = residual_correlation({e}, {}, {});
   ASSERT_TRUE(summary.is_usable()) << summary.message;
   EXPECT_FALSE(summary.residuals_white);
@@ -85,10 +89,7 @@ TEST(ResidualCorrelation, SaysWhichIntervalsToTrust) {
   const std::string wide = white.brief_report(3.0);
   EXPECT_NE(wide.find("the residuals look white, but the Newey-West (HAC) ones are up to 3 times as wide"), std::string::npos) << wide;
   EXPECT_NE(wide.find("trust the Newey-West ones"), std::string::npos) << wide;
-  const auto noise = white_noise(1000, 7);
-  std::vector<double> e(noise.size());
-  e[0] = noise[0];
-  for (std::size_t t = 1; t < e.size(); ++t) e[t] = 0.5 * e[t - 1] + noise[t];
+  const auto e = autoregressive(0.5, 1000, 7);
   const auto correlated = residual_correlation({e}, {}, {});
   ASSERT_TRUE(correlated.is_usable()) << correlated.message;
   EXPECT_TRUE(trust_newey_west(correlated, none));
@@ -97,10 +98,7 @@ TEST(ResidualCorrelation, SaysWhichIntervalsToTrust) {
 
 TEST(ResidualCorrelation, LongRunsOfLagsAreListedAsRanges) {
   // A random walk's residuals: every lag 1..25 outside the band, written as one range.
-  const auto noise = white_noise(1000, 9);
-  std::vector<double> e(noise.size());
-  e[0] = noise[0];
-  for (std::size_t t = 1; t < e.size(); ++t) e[t] = e[t - 1] + noise[t];
+  const auto e = autoregressive(1.0, 1000, 9);
   const auto summary = residual_correlation({e}, {}, {});
   ASSERT_TRUE(summary.is_usable());
   EXPECT_EQ(summary.autocorrelation.lags_outside.size(), 25u);
@@ -110,10 +108,7 @@ TEST(ResidualCorrelation, LongRunsOfLagsAreListedAsRanges) {
 TEST(ResidualCorrelation, WeakAr1IsCaughtByTheWidenedBandAlone) {
   // phi = 0.3 puts only lags 1 and 2 outside the band (not more than chance allows over 25 lags),
   // but lag 1 (0.3) lies far beyond the Bonferroni band (about 3.5/sqrt(N) = 0.11).
-  const auto noise = white_noise(1000, 11);
-  std::vector<double> e(noise.size());
-  e[0] = noise[0];
-  for (std::size_t t = 1; t < e.size(); ++t) e[t] = 0.3 * e[t - 1] + noise[t];
+  const auto e = autoregressive(0.3, 1000, 11);
   const auto summary = residual_correlation({e}, {}, {});
   ASSERT_TRUE(summary.is_usable());
   EXPECT_GT(summary.bonferroni_band, summary.band);

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 
 #include "runtime/operators/block_evaluator.hpp"
+#include "runtime/parallel_ranges.hpp"
 
 namespace sidc {
 namespace {
@@ -60,30 +62,44 @@ std::optional<Diagnostic> add_switch_corrections(Evaluator& evaluator, const Tes
   for (const auto& t : terms) sums.insert(sums.end(), {&t.rest, &t.argument, &t.jump});
   auto prepared = prepare_whole_window_values(evaluator.record(), evaluator.model(), evaluator.options(), window, sums);
   if (auto* d = std::get_if<Diagnostic>(&prepared)) return *d;
-  BlockEvaluator blocks(evaluator.record(), evaluator.options(), window, std::get<WholeWindowValues>(prepared));
+  const WholeWindowValues& whole = std::get<WholeWindowValues>(prepared);
   constexpr std::size_t kBlock = std::size_t{1} << 15;
+  const std::size_t blocks = n > 1 ? (n - 1 + kBlock - 1) / kBlock : 0;
   for (const auto& t : terms) {
-    // The intervals where the switch flips, block by block (each block one sample longer, for the
-    // interval that ends in the next).
+    // The intervals where the switch flips, block by block on the blocks' threads (each block one
+    // sample longer, for the interval that ends in the next); each block keeps its own, in order.
+    std::vector<std::vector<Flip>> found(blocks);
+    std::mutex failed;
+    std::optional<Diagnostic> structural;
+    // Work: three sums a sample, each some tens of operations (a moving arc, a function).
+    for_parallel_ranges(blocks, 64 * n, [&](std::size_t b0, std::size_t b1) {
+      BlockEvaluator block_evaluator(evaluator.record(), evaluator.options(), window, whole);
+      std::vector<double> rest, argument, jump;
+      for (std::size_t b = b0; b < b1; ++b) {
+        const std::size_t start = b * kBlock, last = std::min(n, start + kBlock + 1);
+        for (auto* v : {&rest, &argument, &jump}) v->assign(last - start, 0.0);
+        block_evaluator.start_block(window.first + start, window.first + last);
+        for (auto [sum, values] : {std::pair{&t.rest, &rest}, std::pair{&t.argument, &argument}, std::pair{&t.jump, &jump}}) {
+          auto status = block_evaluator.evaluate(*sum, *values);
+          if (auto* d = std::get_if<Diagnostic>(&status)) {
+            const std::lock_guard<std::mutex> lock(failed);
+            if (!structural) structural = std::move(*d);
+            return;
+          }
+        }
+        for (std::size_t a = 0; a + 1 < last - start; ++a) {
+          if (jump[a] == jump[a + 1]) continue;
+          const double values[] = {rest[a], rest[a + 1], argument[a], argument[a + 1], jump[a], jump[a + 1]};
+          if (!std::all_of(std::begin(values), std::end(values), [](double v) { return std::isfinite(v); })) continue;
+          const double da = argument[a] - argument[a + 1];
+          const double theta = da != 0.0 ? std::clamp(argument[a] / da, 0.0, 1.0) : 0.5;
+          found[b].push_back({start + a, jump[a], jump[a + 1], rest[a], rest[a + 1], theta});
+        }
+      }
+    });
+    if (structural) return structural;
     std::vector<Flip> flips;
-    std::vector<double> rest, argument, jump;
-    for (std::size_t start = 0; start + 1 < n; start += kBlock) {
-      const std::size_t last = std::min(n, start + kBlock + 1);
-      for (auto* v : {&rest, &argument, &jump}) v->assign(last - start, 0.0);
-      blocks.start_block(window.first + start, window.first + last);
-      for (auto [sum, values] : {std::pair{&t.rest, &rest}, std::pair{&t.argument, &argument}, std::pair{&t.jump, &jump}}) {
-        auto status = blocks.evaluate(*sum, *values);
-        if (auto* d = std::get_if<Diagnostic>(&status)) return *d;
-      }
-      for (std::size_t a = 0; a + 1 < last - start; ++a) {
-        if (jump[a] == jump[a + 1]) continue;
-        const double values[] = {rest[a], rest[a + 1], argument[a], argument[a + 1], jump[a], jump[a + 1]};
-        if (!std::all_of(std::begin(values), std::end(values), [](double v) { return std::isfinite(v); })) continue;
-        const double da = argument[a] - argument[a + 1];
-        const double theta = da != 0.0 ? std::clamp(argument[a] / da, 0.0, 1.0) : 0.5;
-        flips.push_back({start + a, jump[a], jump[a + 1], rest[a], rest[a + 1], theta});
-      }
-    }
+    for (auto& f : found) flips.insert(flips.end(), f.begin(), f.end());
     // Row j's support holds the interval [i, i + 1] when c_j - m <= i and i + 1 <= c_j + m. On it
     // the trapezoid takes (F_0 s_0 + F_1 s_1) / 2 with F = w * rest; with the switch at theta and F
     // linear the integral is s_0 int_0^theta F + s_1 int_theta^1 F, which differs from it by

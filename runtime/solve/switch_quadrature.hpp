@@ -8,8 +8,9 @@
 // the interval, as the trapezoid takes it: the error of the location is then of order h^2 and the
 // term's integral of order h^3 per switch (the same record: 0.037%).
 //
-// Relies on: block_evaluator.hpp (the values, block by block: memory of a block, not of the
-// record), test_functions.hpp (the subdomains and phi's quadrature weights). Guarantees: a term
+// Relies on: block_evaluator.hpp (the values, block by block on the cores: memory of a block, not
+// of the record; the flips found in block order, so the rows are the same on any number of cores),
+// test_functions.hpp (the subdomains and phi's quadrature weights). Guarantees: a term
 // with exactly one switching factor to the power 1 (sign(), or a guard of one condition) outside
 // any integral or function, that jumps there (its other factors do not vanish with the switch's
 // argument, as y' * [y' > 0] does), is corrected, every other term is left to the trapezoid; intervals

@@ -12,6 +12,10 @@ int derivative_burden(const ir::Equation& e) {
   return b;
 }
 
+bool is_switch(const ir::Factor& f) {
+  return f.kind == ir::FactorKind::guard || (f.kind == ir::FactorKind::function && f.name == "sign");
+}
+
 bool is_dynamic(const ir::Sum& s) {
   return ir::any_factor(s, [](const ir::Factor& f) {
     switch (f.kind) {

@@ -13,6 +13,11 @@ namespace sidc {
 // The highest derivative order anywhere in the equation, inside integrals and functions too.
 int derivative_burden(const ir::Equation& e);
 
+// True for a factor that jumps where its argument crosses zero: a guard, or sign() (a guard in
+// disguise). The weak form locates its switches, the rows' covariance and a threshold's curvature
+// leave it out.
+bool is_switch(const ir::Factor& f);
+
 // True when the sum changes with time: a derivative, t, tau, der() or int() anywhere in it.
 bool is_dynamic(const ir::Sum& s);
 

@@ -4,15 +4,12 @@
 #include <cmath>
 #include <mutex>
 
+#include "ir/queries.hpp"
 #include "runtime/operators/block_evaluator.hpp"
 #include "runtime/parallel_ranges.hpp"
 
 namespace sidc {
 namespace {
-
-bool is_switch(const ir::Factor& f) {
-  return (f.kind == ir::FactorKind::function && f.name == "sign") || (f.kind == ir::FactorKind::guard && !f.conditions.empty());
-}
 
 // Where the switch changes value on one sample interval [i, i + 1] of the window.
 struct Flip {

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "ir/fix_parameters.hpp"
+#include "ir/queries.hpp"
 #include "ir/traversal.hpp"
 
 namespace sidc {
@@ -136,7 +137,7 @@ void nelder_mead(Objective& f, std::vector<double>& best, double& best_value, co
 const ir::Parameter* threshold(const ir::Model& model) {
   const ir::Parameter* found = nullptr;
   const auto visit = [&](const ir::Factor& f, const ir::Term&) {
-    if (f.kind == ir::FactorKind::guard || (f.kind == ir::FactorKind::function && f.name == "sign"))
+    if (is_switch(f))
       ir::for_each_nested_sum(f, [&](const ir::Sum& inner) {
         ir::for_each_factor(inner, [&](const ir::Factor& g) {
           if (g.kind == ir::FactorKind::parameter && !found) found = &model.parameters[static_cast<std::size_t>(g.order)];

@@ -12,6 +12,7 @@
 
 #include "ir/differentiate.hpp"
 #include "ir/print.hpp"
+#include "ir/queries.hpp"
 #include "ir/traversal.hpp"
 #include "runtime/operators/test_functions.hpp"
 
@@ -56,8 +57,7 @@ std::variant<std::vector<Sensitivity>, std::string> sensitivities(const ir::Mode
         // first-order effect, so no covariance of first order describes it.
         const ir::Factor* noisy_switch = nullptr;
         ir::for_each_factor(g, [&](const ir::Factor& f) {
-          const bool is_switch = f.kind == ir::FactorKind::guard || (f.kind == ir::FactorKind::function && f.name == "sign");
-          if (!is_switch || noisy_switch) return;
+          if (!is_switch(f) || noisy_switch) return;
           ir::Sum inside = f.argument ? *f.argument : ir::Sum{};
           for (const auto& c : f.conditions) inside = ir::add(ir::add(inside, *c.lhs), *c.rhs);
           if (ir::any_factor(inside, [&](const ir::Factor& x) { return x.kind == ir::FactorKind::signal && x.name == signal; }))

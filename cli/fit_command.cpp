@@ -22,6 +22,7 @@
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "distributed/session.hpp"
 #include "driver/fit_run.hpp"
 #include "report/fit_files.hpp"
 #include "report/text_reports.hpp"
@@ -50,6 +51,7 @@ struct FitArguments {
   std::optional<double> local;        // --local WIDTH: local fits (thesis chapter V), over `set local`
   std::size_t stride = 1;             // --stride S
   std::optional<double> forget;       // --forget LAMBDA
+  std::optional<std::size_t> stream_above;  // --stream-above ENTRIES
 };
 
 // The compiled model to fit when none is named: the only *.sidc.json in the current directory, so
@@ -85,6 +87,12 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   settings.local = a.local;
   settings.stride = a.stride;
   settings.forget = a.forget;
+  settings.stream_above = a.stream_above;
+  // Under mpirun: the rows shared among the ranks, rank 0 alone printing and writing (session.hpp).
+  distributed::Session& session = distributed::Session::current();
+  settings.share = session.row_share();
+  settings.threads = session.threads_per_rank();
+  settings.processes = session.processes_line();
   ProgressLine progress;  // on stderr, only when it is a terminal
   const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; },
                                 [&progress](const std::string& phase, std::size_t done, std::size_t total) {
@@ -103,7 +111,9 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   if (auto f = driver::run_fit(run, print)) return fail(*f);
   const ir::Model& model = run.compiled.integrated;
   const FitSummary& summary = run.summary;
-  if (!out_dir.empty()) {
+  // Every rank has fitted, or the job stops here without a file written.
+  if (!session.agree(exit_code::success)) return fail(render(diag::error("stopped", {}, session.who_left())), exit_code::user_error);
+  if (!out_dir.empty() && session.is_writer()) {
     auto written = driver::write_files(run, out_dir);
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     const auto& paths = std::get<std::vector<std::string>>(written);
@@ -111,7 +121,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
     for (std::size_t i = 0; i < paths.size(); ++i) list += (i == 0 ? "" : i + 1 == paths.size() ? " and " : ", ") + paths[i];
     std::cerr << "wrote " << list << "\n";
   }
-  if (!a.plots.empty() || !a.report.empty()) {
+  if ((!a.plots.empty() || !a.report.empty()) && session.is_writer()) {
     std::vector<std::string> written;
     if (!driver::write_pictures(run, {a.plots, a.report}, written, error)) return fail(error, exit_code::user_error);
     if (!a.plots.empty()) std::cerr << fmt::format("wrote {} pictures into {}\n", written.size() - (a.report.empty() ? 0 : 1), a.plots);
@@ -195,6 +205,11 @@ void add_fit_command(CLI::App& app, int& exit_status) {
                   "0 < LAMBDA < 1 (memory about 1/(1 - LAMBDA) samples)")
       ->check(number_check("LAMBDA", [](double v) { return v > 0 && v < 1; },
                            "LAMBDA must lie strictly between 0 and 1, e.g. 0.999 (1 forgets nothing: that is the global fit)"));
+  cmd->add_option("--stream-above", a->stream_above,
+                  "Fold the rows into a triangular factor block by block (streamed QR: memory that does not grow with the record) "
+                  "when a group's design has more than this many entries, rows x parameters (default 8000000; 0 = always). "
+                  "Under mpirun the ranks share the streamed rows (docs/distributed.md)")
+      ->check(whole_number_check(0));
   cmd->add_flag("--refine", a->refine,
                 "Refine the parameters by the output error: Levenberg-Marquardt over the parameters and each record's initial state, "
                 "minimising the difference between the records and the solved equations (as `set refine = simulation`)");

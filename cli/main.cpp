@@ -18,6 +18,7 @@
 #include "cli/fit_command.hpp"
 #include "cli/simulate_command.hpp"
 #include "cli/select_command.hpp"
+#include "distributed/session.hpp"
 #include "diagnostics/cli_catalogue.hpp"
 #include "diagnostics/model_catalogue.hpp"
 
@@ -36,10 +37,11 @@ int with_stdout_checked(int code) {
   return code == sidc::exit_code::success ? sidc::exit_code::user_error : code;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run_command(int argc, char** argv, const sidc::distributed::Session& session) {
   std::signal(SIGPIPE, SIG_IGN);
+  // Only `fit` shares its work among ranks; any other command runs on rank 0 alone, so that two
+  // ranks never write the same file.
+  if (session.size() > 1 && !session.is_writer() && (argc < 2 || std::string(argv[1]) != "fit")) return sidc::exit_code::success;
   CLI::App app{"sidc: identify the parameters and operations of dynamic systems from recorded data\n"
                "(the method of W. D. Bernhart, 1964). Main path: sidc compile model.sid && sidc fit"};
   app.name("sidc");  // in --help, whatever path the binary was run by
@@ -75,4 +77,13 @@ int main(int argc, char** argv) {
     return sidc::exit_code::internal_error;
   }
   return with_stdout_checked(exit_status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Under mpirun, every rank; one process otherwise (distributed/session.hpp). Every return below
+  // goes through finish(), the ranks' last exchange.
+  auto& session = sidc::distributed::Session::start(argc, argv);
+  return session.finish(run_command(argc, argv, session));
 }

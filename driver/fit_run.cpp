@@ -114,6 +114,9 @@ std::variant<std::unique_ptr<FitRun>, Failure> prepare_fit(CompiledModel compile
   auto options = fit_options(c.integrated, run->settings.records);
   if (auto* d = std::get_if<Diagnostic>(&options)) return failure(*d, true);
   run->options = std::get<FitOptions>(options);
+  if (f.stream_above) run->options.stream_above_entries = *f.stream_above;
+  run->options.share = f.share;
+  if (f.threads > 0) run->options.stream_threads = f.threads;
   // The projection compares G at trial values; whitened rows would change their metric with every
   // trial (a profile of generalised least squares needs the covariance's determinant as well).
   if (run->nonlinear) {
@@ -179,7 +182,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   for (const auto& g : summary.groups)
     for (const auto& w : drift_warnings(model, g.drift)) out.warning(render(w));
   for (const auto& w : statistics_warnings(model, summary)) out.warning(render(w));
-  std::string report = fmt::format("sidc fit: model `{}` ({})\n\n", model.name, run.model_path) + form_report + (form_report.empty() ? "" : "\n") +
+  std::string report = fmt::format("sidc fit: model `{}` ({})\n{}\n", model.name, run.model_path, a.processes.empty() ? "" : a.processes + "\n") + form_report + (form_report.empty() ? "" : "\n") +
                        operator_report(summary.operators, o.evaluation, model);
   if (!is_static(model)) report += "\n";
   out.report(report + summary.full_report(model));

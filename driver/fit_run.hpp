@@ -54,6 +54,14 @@ struct FitSettings {
   std::optional<double> local;
   std::size_t stride = 1;
   std::optional<double> forget;
+  // How the fit runs: streamed above this many design entries (FitOptions::stream_above_entries;
+  // unset: the default), its rows shared among processes (`share`, not owned; the command line under
+  // mpirun) on `threads` threads each (0: one per core), and the line naming the processes, printed
+  // under the report's title (empty for one process).
+  std::optional<std::size_t> stream_above;
+  RowShare* share = nullptr;
+  int threads = 0;
+  std::string processes;
 };
 
 // Where the text goes as it is known: `report` takes what `sidc fit` prints on stdout, `warning` one

@@ -22,7 +22,8 @@ shift || true
 required_packages=(g++ cmake ninja-build libeigen3-dev libboost-dev libfmt-dev libcli11-dev
                    libceres-dev nlohmann-json3-dev libgtest-dev libbenchmark-dev gnuplot-nox python3-minimal
                    clang libclang-rt-dev   # Clang and libFuzzer: the sanitizer and fuzz build (scripts/test.sh)
-                   pybind11-dev python3-pybind11 python3-numpy python3-dev)  # the Python module (docs/python.md)
+                   pybind11-dev python3-pybind11 python3-numpy python3-dev  # the Python module (docs/python.md)
+                   libopenmpi-dev openmpi-bin)  # mpirun -np N sidc fit (docs/distributed.md)
 
 # One dpkg-query call for all packages: it exits 1 when some are unknown, which is expected here,
 # so its status is ignored and only the packages reported as fully installed count as present.

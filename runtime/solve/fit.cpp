@@ -80,6 +80,9 @@ std::variant<std::vector<Region>, Diagnostic> count_regions(const ir::Model& mod
   return regions;
 }
 
+// A shared group's region counts travel as one count per combination of guards.
+constexpr std::size_t kMostSharedGuards = 16;
+
 // What the streamed path needs besides the model and the records, shared read-only by its threads.
 struct StreamPlan {
   const ir::Model& model;
@@ -261,25 +264,42 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   };
   // Carried integrals advance over stretches of FitOptions::stream_stretch_rows, each stretch's
   // integrands evaluated and its rows folded on every thread; prepared ones are one stretch.
+  // Shared among processes (FitOptions::share, row_share.hpp), this process folds only its share
+  // [share_first, share_last) of all rows, counted record by record and equation by equation.
   std::size_t folded = 0, to_fold = 0;
   for (const auto& w : windows) to_fold += w.size() * g.equations.size();
-  for (std::size_t r = 0; r < records.size(); ++r) {
+  RowShare* share = options.share && options.share->parts() > 1 && plan.guard_sums.size() <= kMostSharedGuards ? options.share : nullptr;
+  const auto [share_first, share_last] =
+      share ? RowShare::share_of(to_fold, block_rows, share->part(), share->parts()) : std::pair<std::size_t, std::size_t>{0, to_fold};
+  bool has_problem = false;  // shared: a problem met, to be named by every process alike (below)
+  std::size_t offset = 0;    // rows of the records and equations before this one
+  for (std::size_t r = 0; r < records.size() && !has_problem; ++r) {
     RunningIntegrals& running = integrals[r];
     const std::size_t n = windows[r].size(), stretch = running.stretch_rows(options.stream_stretch_rows);
     for (std::size_t e : g.equations) {
+      const std::size_t mine_first = std::clamp(share_first, offset, offset + n) - offset;
+      const std::size_t mine_last = std::clamp(share_last, offset, offset + n) - offset;
+      offset += n;
+      if (mine_first == mine_last) continue;  // none of this equation's rows on this record are ours
       running.restart();  // from t0 again for each equation
-      for (std::size_t begin = 0; begin < n; begin += stretch) {
-        const std::size_t end = std::min(n, begin + stretch);
-        if (auto problem = running.advance(end, threads, block_rows)) return problem;
-        fold_parts(running.values(), r, e, begin, end);
-        folded += end - begin;
-        if (options.progress) options.progress(folded, to_fold);
+      for (std::size_t begin = 0; begin < mine_last; begin += stretch) {
+        const std::size_t end = std::min(mine_last, begin + stretch);
+        if (auto problem = running.advance(end, threads, block_rows)) {
+          if (!share) return problem;
+          has_problem = true;
+          break;
+        }
+        if (end > mine_first) fold_parts(running.values(), r, e, std::max(begin, mine_first), end);
+        folded += end - std::max(begin, mine_first);
+        if (options.progress) options.progress(folded, share_last - share_first);
       }
       // The dense path's first problem: the smallest key over the parts of this record and equation.
       Problem first;
       for (auto& w : workers)
         if (w.problem && (!first || w.problem->first < first->first)) first = w.problem;
-      if (first) return first->second;
+      if (first && !share) return first->second;
+      has_problem = has_problem || first;
+      if (has_problem) break;
     }
   }
   // count_regions runs after the whole design: a guard's problem only after every operation of
@@ -288,31 +308,70 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
     Problem first;
     for (auto& w : workers)
       if (w.guard_problem && (!first || w.guard_problem->first < first->first)) first = w.guard_problem;
-    if (first) return first->second;
+    if (first && !share) return first->second;
+    has_problem = has_problem || first;
   }
-  std::map<std::string, std::size_t> counts;
-  for (auto& w : workers)
-    for (const auto& [mask, rows] : w.region_rows) {
-      std::string text;
-      for (std::size_t k = 0; k < mask.size(); ++k)
-        if (mask[k] == '1') text += (text.empty() ? "" : " and ") + plan.guard_texts[k];
-      counts[text.empty() ? "(no guard)" : text] += rows;
-    }
-  for (auto& [text, rows] : counts) g.regions.push_back({text, rows});
-  if (auto problem = design.too_few_rows(total_rows, evaluation.front())) return problem;
-
   for (std::size_t k = 1; k < workers.size(); ++k) workers[0].accumulator.merge(workers[k].accumulator);
-  const auto clock = std::chrono::steady_clock::now();
-  g.summary = workers[0].accumulator.solve(g.columns, options.least_squares);
-  g.solve_seconds = seconds_since(clock);
-  design.label(g.summary);
+  std::map<std::string, std::size_t> masks;
+  for (auto& w : workers)
+    for (const auto& [mask, rows] : w.region_rows) masks[mask] += rows;
   for (const auto& w : workers) {
     g.evaluate_seconds += w.evaluate_seconds;
     g.fold_seconds += w.fold_seconds;
   }
+  if (share) {
+    // Region counts by mask (2^guards of them) and the CPU seconds, summed over the processes.
+    const std::size_t guards = plan.guard_sums.size();
+    std::vector<double> sums(std::size_t{1} << guards, 0.0);
+    for (const auto& [mask, rows] : masks) {
+      std::size_t bits = 0;
+      for (std::size_t k = 0; k < guards; ++k) bits |= mask[k] == '1' ? std::size_t{1} << k : 0;
+      sums[bits] = static_cast<double>(rows);
+    }
+    sums.push_back(g.evaluate_seconds);
+    sums.push_back(g.fold_seconds);
+    const RowShare::Combined combined = share->combine(workers[0].accumulator, sums, has_problem);
+    if (combined.outcome == RowShare::Outcome::stopped) return diag::error("stopped", {}, combined.why);
+    if (combined.outcome == RowShare::Outcome::problem) {
+      // Some process met a problem in its rows: every process evaluates all rows alone, and so names
+      // the problem a single process names (a failing fit pays twice, a good one never).
+      FitOptions alone = options;
+      alone.share = nullptr;
+      g.regions.clear();
+      g.evaluate_seconds = g.fold_seconds = 0;
+      if (auto problem = stream_group(model, records, windows, alone, evaluation, design, total_rows, g)) return problem;
+      return diag::error("stopped", {}, "the processes disagree: a problem one of them met in its rows is not met by one process alone");
+    }
+    masks.clear();
+    for (std::size_t bits = 0; bits + 2 < sums.size(); ++bits) {
+      if (sums[bits] == 0) continue;
+      std::string mask(guards, '0');
+      for (std::size_t k = 0; k < guards; ++k) mask[k] = bits & (std::size_t{1} << k) ? '1' : '0';
+      masks[mask] = static_cast<std::size_t>(sums[bits]);
+    }
+    g.evaluate_seconds = sums[sums.size() - 2];
+    g.fold_seconds = sums.back();
+  }
+  std::map<std::string, std::size_t> counts;
+  for (const auto& [mask, rows] : masks) {
+    std::string text;
+    for (std::size_t k = 0; k < mask.size(); ++k)
+      if (mask[k] == '1') text += (text.empty() ? "" : " and ") + plan.guard_texts[k];
+    counts[text.empty() ? "(no guard)" : text] += rows;
+  }
+  for (auto& [text, rows] : counts) g.regions.push_back({text, rows});
+  if (auto problem = design.too_few_rows(total_rows, evaluation.front())) return problem;
+
+  const auto clock = std::chrono::steady_clock::now();
+  g.summary = workers[0].accumulator.solve(g.columns, options.least_squares);
+  g.solve_seconds = seconds_since(clock);
+  design.label(g.summary);
   g.hac.note = "not computed for a streamed fit (its rows are folded into the triangle, not kept)";
   g.streamed = fmt::format("streamed QR over {} rows in blocks of {} rows on {} thread{}", total_rows, block_rows, threads_used,
                            threads_used == 1 ? "" : "s");
+  if (share)
+    g.streamed = fmt::format("streamed QR over {} rows in blocks of {} rows on {} processes (MPI ranks) of {} thread{} each, "
+                             "their factors merged (TSQR)", total_rows, block_rows, share->parts(), threads_used, threads_used == 1 ? "" : "s");
   return std::nullopt;
 }
 

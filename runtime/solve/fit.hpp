@@ -31,6 +31,7 @@
 #include "runtime/solve/drift_check.hpp"
 #include "runtime/solve/hac_covariance.hpp"
 #include "runtime/solve/least_squares.hpp"
+#include "runtime/solve/row_share.hpp"
 #include "runtime/solve/weak_covariance.hpp"
 
 namespace sidc {
@@ -58,6 +59,10 @@ struct FitOptions {
   std::function<void(std::size_t done, std::size_t total)> progress;
   // The weak form's rows weighted by the covariance their noise gives them (weak_covariance.hpp;
   // `set weak_weighting = covariance`, the default); false: least squares of independent rows.
+  // Optional, not owned: the processes a streamed group's rows are shared among (row_share.hpp; the
+  // command line under mpirun, distributed/). Every process runs the same fit; a dense group is
+  // fitted whole by each, and so is a group with more than 16 guards (2^guards region counts).
+  RowShare* share = nullptr;
   bool weak_covariance = true;
   std::string weak_covariance_off = "set weak_weighting = none";  // why not, for the report, when false
   bool is_valid(std::string* why) const;

@@ -201,6 +201,54 @@ bool TriangularAccumulator::merge(const TriangularAccumulator& other, std::strin
   return true;
 }
 
+namespace {
+void put_long(std::vector<double>& out, long double x) {
+  const double hi = static_cast<double>(x);
+  out.push_back(hi);
+  out.push_back(static_cast<double>(x - hi));
+}
+long double get_long(const double*& p) {
+  const long double x = static_cast<long double>(p[0]) + static_cast<long double>(p[1]);
+  p += 2;
+  return x;
+}
+}  // namespace
+
+std::vector<double> TriangularAccumulator::to_doubles() const {
+  std::vector<double> out;
+  const auto width = static_cast<std::size_t>(p_ + 1);
+  out.reserve(width * width + 2 * static_cast<std::size_t>(p_) + 11);
+  out.push_back(static_cast<double>(p_));
+  out.insert(out.end(), triangle_.data(), triangle_.data() + triangle_.size());
+  out.push_back(static_cast<double>(rows_));  // exact below 2^53 rows
+  out.push_back(static_cast<double>(rejected_blocks_));
+  for (char c : column_constant_) out.push_back(c ? 1.0 : 0.0);
+  out.insert(out.end(), column_value_.begin(), column_value_.end());
+  for (long double x : {weight_sum_, mean_, centred_squares_, uncentred_squares_}) put_long(out, x);
+  return out;
+}
+
+bool TriangularAccumulator::from_doubles(const std::vector<double>& state, std::string* why) {
+  const auto width = static_cast<std::size_t>(p_ + 1);
+  const std::size_t expected = 1 + width * width + 2 + 2 * static_cast<std::size_t>(p_) + 8;
+  if (state.size() != expected || state[0] != static_cast<double>(p_)) {
+    if (why) *why = fmt::format("an accumulator state of {} values for {} columns, expected {}", state.size(), state.empty() ? -1.0 : state[0], expected);
+    return false;
+  }
+  const double* p = state.data() + 1;
+  std::copy(p, p + width * width, triangle_.data());
+  p += width * width;
+  rows_ = static_cast<std::size_t>(*p++);
+  rejected_blocks_ = static_cast<std::size_t>(*p++);
+  for (auto& c : column_constant_) c = *p++ != 0.0 ? 1 : 0;
+  for (auto& v : column_value_) v = *p++;
+  weight_sum_ = get_long(p);
+  mean_ = get_long(p);
+  centred_squares_ = get_long(p);
+  uncentred_squares_ = get_long(p);
+  return true;
+}
+
 TriangularSystem TriangularAccumulator::system() const {
   TriangularSystem system;
   system.R = triangle_.topLeftCorner(p_, p_);

@@ -54,6 +54,14 @@ class TriangularAccumulator {
   // Adds the rows another accumulator has seen (same p). Returns false when p differs.
   bool merge(const TriangularAccumulator& other, std::string* why = nullptr);
 
+  // The whole state as doubles, to send to another process (distributed/, TSQR): the factor, the
+  // counts and the constant-column marks, and each long-double total as an exact pair of doubles
+  // (hi + lo: a double pair holds a long double's 64-bit mantissa). from_doubles reads it back
+  // into an accumulator of the same p (false, with `why`, when the size does not match); the
+  // first rejection's text stays with the process that met it.
+  std::vector<double> to_doubles() const;
+  bool from_doubles(const std::vector<double>& state, std::string* why = nullptr);
+
   LeastSquaresSummary solve(const std::vector<std::string>& column_names, const LeastSquaresOptions& options) const;
 
   TriangularSystem system() const;  // what solve() hands to solve_least_squares

@@ -8,7 +8,7 @@
                                              each to be reported at its file and line
 
 Data flows one way: diagnostics/ and ir/ at the bottom, grammar/ -> compiler/ -> runtime/ ->
-report/ -> driver/ -> cli/. A folder may include its own headers and those of the layers it lists below;
+report/ -> driver/ -> cli/, with distributed/ (on runtime/) beside driver/. A folder may include its own headers and those of the layers it lists below;
 everything outside the layers (tests/, bench/, examples/) may include any layer but cli/.
 Includes are read as the project writes them, by paths relative to the repository root
 (`#include "runtime/solve/fit.hpp"`). Every path is normalised first (`a/../b`); a quoted path
@@ -24,7 +24,7 @@ import sys
 import tempfile
 
 # What each layer may include besides itself. cli/ may include every layer.
-LAYERS = ["diagnostics", "ir", "grammar", "compiler", "runtime", "report", "driver", "cli"]
+LAYERS = ["diagnostics", "ir", "grammar", "compiler", "runtime", "report", "driver", "distributed", "cli"]
 ALLOWED = {
     "diagnostics": set(),
     "ir": {"diagnostics"},
@@ -33,7 +33,9 @@ ALLOWED = {
     "runtime": {"ir", "diagnostics"},
     "report": {"runtime", "ir", "diagnostics"},
     "driver": {"report", "runtime", "compiler", "grammar", "ir", "diagnostics"},
-    "cli": {"driver", "report", "runtime", "compiler", "grammar", "ir", "diagnostics"},
+    # distributed/: the processes of one command (MPI); it implements runtime/'s RowShare.
+    "distributed": {"runtime", "ir", "diagnostics"},
+    "cli": {"driver", "distributed", "report", "runtime", "compiler", "grammar", "ir", "diagnostics"},
 }
 SOURCE_SUFFIXES = (".hpp", ".cpp", ".h", ".hh", ".cc", ".cxx", ".hxx", ".ipp", ".inl", ".tpp")
 INCLUDE = re.compile(r'^\s*#\s*include\s*(["<])([^">]+)[">]')

@@ -1,0 +1,211 @@
+// distributed/session.hpp: the processes of one command, over MPI when sidc was built with it.
+#include "distributed/session.hpp"
+
+#include <fmt/format.h>
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <thread>
+#include <unistd.h>
+
+#ifdef SIDC_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace sidc::distributed {
+namespace {
+
+std::unique_ptr<Session>& instance() {
+  static std::unique_ptr<Session> session;
+  return session;
+}
+
+// True when a launcher (mpirun, srun) started this process as one rank of a job.
+bool launched_as_rank() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
+    if (std::getenv(name)) return true;
+  return false;
+}
+
+}  // namespace
+
+#ifdef SIDC_HAVE_MPI
+// The rows' share over MPI: a status exchange, then a binary tree of factor merges to rank 0
+// (rank r takes r + 1, r + 2, r + 4, ... in that order: the same bits on every run), and the
+// merged factor broadcast back, so that every rank goes on with the factor of all rows.
+struct Session::Share final : RowShare {
+  explicit Share(Session& s) : session(s) {}
+  int part() const override { return session.rank_; }
+  int parts() const override { return session.size_; }
+
+  Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem) override {
+    const std::vector<int> statuses = session.exchange(has_problem ? working_with_problem : working);
+    if (session.someone_left_) return {Outcome::stopped, session.who_left()};
+    if (std::any_of(statuses.begin(), statuses.end(), [](int s) { return s == working_with_problem; })) return {Outcome::problem, {}};
+    std::vector<double> state = accumulator.to_doubles();
+    const std::size_t factor_size = state.size();
+    state.insert(state.end(), counts.begin(), counts.end());
+    const int length = static_cast<int>(state.size());
+    std::vector<double> theirs(state.size());
+    TriangularAccumulator other(accumulator.columns());
+    const int rank = session.rank_, size = session.size_;
+    for (int step = 1; step < size; step *= 2) {
+      if (rank % (2 * step) != 0) {  // hand this subtree's rows up and leave the tree
+        MPI_Send(state.data(), length, MPI_DOUBLE, rank - step, 17, MPI_COMM_WORLD);
+        break;
+      }
+      if (rank + step >= size) continue;
+      MPI_Recv(theirs.data(), length, MPI_DOUBLE, rank + step, 17, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      other.from_doubles(std::vector<double>(theirs.begin(), theirs.begin() + static_cast<std::ptrdiff_t>(factor_size)));
+      accumulator.merge(other);
+      std::vector<double> merged = accumulator.to_doubles();
+      for (std::size_t k = factor_size; k < state.size(); ++k) merged.push_back(state[k] + theirs[k]);
+      state = std::move(merged);
+    }
+    MPI_Bcast(state.data(), length, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    accumulator.from_doubles(std::vector<double>(state.begin(), state.begin() + static_cast<std::ptrdiff_t>(factor_size)));
+    counts.assign(state.begin() + static_cast<std::ptrdiff_t>(factor_size), state.end());
+    return {Outcome::combined, {}};
+  }
+
+  Session& session;
+};
+
+Session& Session::start(int& argc, char**& argv) {
+  auto& session = instance();
+  session.reset(new Session());
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  if (!launched_as_rank()) return *session;
+  int provided = 0;
+  // Only the main thread talks to MPI; the fold's own threads never do.
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  session->mpi_ = true;
+  MPI_Comm_rank(MPI_COMM_WORLD, &session->rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &session->size_);
+  MPI_Comm node;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, session->rank_, MPI_INFO_NULL, &node);
+  int on_node = 1;
+  MPI_Comm_size(node, &on_node);
+  MPI_Comm_free(&node);
+  session->threads_per_rank_ = static_cast<int>(std::max(1u, cores / static_cast<unsigned>(std::max(on_node, 1))));
+  if (session->size_ > 1) session->share_ = new Share(*session);
+  if (session->rank_ > 0) {
+    // Nothing on stdout; stderr held in an unnamed file until finish() decides whether to show it.
+    std::fflush(stdout);
+    if (std::FILE* null = std::freopen("/dev/null", "w", stdout); !null) std::fclose(stdout);
+    if (std::FILE* held = std::tmpfile()) {
+      std::fflush(stderr);
+      session->real_stderr_ = dup(STDERR_FILENO);
+      session->held_stderr_ = dup(fileno(held));
+      dup2(session->held_stderr_, STDERR_FILENO);
+      std::fclose(held);
+    }
+  }
+  return *session;
+}
+
+std::vector<int> Session::exchange(Status mine) {
+  std::vector<int> mine_only(static_cast<std::size_t>(size_), -1), statuses(static_cast<std::size_t>(size_), -1);
+  mine_only[static_cast<std::size_t>(rank_)] = mine;
+  MPI_Allreduce(mine_only.data(), statuses.data(), size_, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  last_statuses_ = statuses;
+  if (mine >= finished_ok) left_ = true;  // no further exchange from this rank
+  for (std::size_t r = 0; r < statuses.size(); ++r)
+    if (static_cast<int>(r) != rank_ && statuses[r] >= finished_ok) someone_left_ = true;
+  return statuses;
+}
+
+Session::~Session() {
+  delete share_;
+}
+
+int Session::finish(int my_code) {
+  if (!mpi_) return my_code;
+  bool show_held = false;
+  if (!someone_left_ && !left_) {
+    const std::vector<int> statuses = exchange(my_code == 0 ? finished_ok : finished_failed);
+    // Shown when rank 0 did not fail: rank 0 then names this rank, and its error is only here.
+    show_held = my_code != 0 && rank_ > 0 && statuses[0] != finished_failed;
+    if (my_code == 0 && std::any_of(statuses.begin(), statuses.end(), [](int s) { return s == finished_failed; })) my_code = 1;
+  } else {
+    show_held = my_code != 0 && rank_ > 0 && last_statuses_[0] != finished_failed;
+  }
+  if (rank_ > 0 && real_stderr_ >= 0) {
+    std::fflush(stderr);
+    if (show_held && held_stderr_ >= 0) {
+      std::string text;
+      char buffer[4096];
+      lseek(held_stderr_, 0, SEEK_SET);
+      for (ssize_t got; (got = read(held_stderr_, buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(got));
+      std::string shown;
+      for (std::size_t begin = 0; begin < text.size();) {
+        const std::size_t end = std::min(text.find('\n', begin), text.size());
+        shown += fmt::format("[rank {}] {}\n", rank_, text.substr(begin, end - begin));
+        begin = end + 1;
+      }
+      if (write(real_stderr_, shown.data(), shown.size()) < 0) my_code = my_code ? my_code : 1;
+    }
+  }
+  // Collective: a rank that left earlier waits in its own MPI_Finalize for the others.
+  MPI_Finalize();
+  return my_code;
+}
+
+bool Session::agree(int my_code) {
+  if (!mpi_ || size_ == 1) return my_code == 0;
+  if (someone_left_) return false;
+  // Not a finish: a rank that failed is in its finish() and meets this exchange there.
+  const std::vector<int> statuses = exchange(my_code == 0 ? working : finished_failed);
+  if (my_code != 0) return false;
+  return std::none_of(statuses.begin(), statuses.end(), [](int s) { return s >= finished_ok; });
+}
+#else
+struct Session::Share {};
+
+Session& Session::start(int&, char**&) {
+  instance().reset(new Session());
+  return *instance();
+}
+std::vector<int> Session::exchange(Status) { return {}; }
+Session::~Session() = default;
+int Session::finish(int my_code) { return my_code; }
+bool Session::agree(int my_code) { return my_code == 0; }
+#endif
+
+Session& Session::current() {
+  if (!instance()) {
+    int argc = 0;
+    char** argv = nullptr;
+    return start(argc, argv);
+  }
+  return *instance();
+}
+
+RowShare* Session::row_share() {
+#ifdef SIDC_HAVE_MPI
+  return share_;
+#else
+  return nullptr;
+#endif
+}
+
+std::string Session::who_left() const {
+  std::string ranks;
+  for (std::size_t r = 0; r < last_statuses_.size(); ++r)
+    if (static_cast<int>(r) != rank_ && last_statuses_[r] >= finished_ok)
+      ranks += (ranks.empty() ? "" : ", ") + std::to_string(r);
+  const std::string first = ranks.substr(0, ranks.find(','));
+  return fmt::format("{} {} of the {} MPI processes stopped with an error (its lines on stderr begin with [rank {}]); "
+                     "the job stops without writing any file", first == ranks ? "rank" : "ranks", ranks, size_, first);
+}
+
+std::string Session::processes_line() const {
+  if (size_ <= 1) return {};
+  return fmt::format("processes: {} MPI ranks of {} thread{} each; the rows of every streamed group are shared among them, "
+                     "smaller groups are fitted whole by each (docs/distributed.md)",
+                     size_, threads_per_rank_, threads_per_rank_ == 1 ? "" : "s");
+}
+
+}  // namespace sidc::distributed

@@ -1,0 +1,151 @@
+#!/usr/bin/env python3
+"""`mpirun -np N sidc fit` against `sidc fit` (issue 17, docs/distributed.md).
+
+For every case (bundled examples, the NIST sets, a fit of two records) and N = 2 and 3 ranks
+(oversubscribed on a smaller machine), with every group streamed (`--stream-above 0`) so that the
+ranks really share the rows:
+- the same exit code, and the same report on stdout apart from the line naming the processes and
+  the streamed group's "solved:" line (threads and ranks);
+- fit.json's estimates and standard errors equal to the single process's to 1e-12 relative (of the
+  group's largest estimate), its statistics (G, n, rank) alike;
+- nothing on stdout from the ranks above 0 (one report, not N).
+Then the faults: a rank whose record is broken (MPMD: rank 1 started in another directory) stops
+the whole job with exit 1 and that rank's error (file, row, column), and no file is written; a
+job whose ranks all meet the same error prints it once. Without mpirun nothing names processes.
+
+Usage: mpi_fit_test.py SIDC MPIEXEC REPO
+"""
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+sidc, mpiexec, repo = sys.argv[1], sys.argv[2], sys.argv[3]
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+           OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_btl_vader_single_copy_mechanism="none")
+failures = []
+
+
+def run(args, cwd):
+    return subprocess.run(args, cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+
+
+def normalised(report):
+    """The report without the line naming the processes; the "solved:" line without who folded."""
+    lines = []
+    for line in report.splitlines():
+        if line.startswith("processes: "):
+            continue
+        if "streamed QR over" in line:
+            line = line[: line.index(" on ")] + " on (threads or ranks)"
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def compare_json(one, many, label):
+    a, b = json.load(open(one)), json.load(open(many))
+    for ga, gb in zip(a["groups"], b["groups"], strict=True):
+        scale = max([abs(p["estimate"]) for p in ga["parameters"]] + [1e-300])
+        for pa, pb in zip(ga["parameters"], gb["parameters"], strict=True):
+            for key in ("estimate", "standard_error"):
+                x, y = pa[key], pb[key]
+                if x is None or y is None:
+                    ok = x == y
+                else:
+                    ok = abs(x - y) <= 1e-12 * max(scale if key == "estimate" else abs(x), 1e-300)
+                if not ok:
+                    failures.append(f"{label}: {pa['name']} {key} {x!r} (one process) vs {y!r}")
+        for key in ("n", "p", "rank"):
+            if ga["statistics"][key] != gb["statistics"][key]:
+                failures.append(f"{label}: statistics {key} {ga['statistics'][key]} vs {gb['statistics'][key]}")
+        g1, g2 = ga["statistics"]["G"], gb["statistics"]["G"]
+        if not math.isclose(g1, g2, rel_tol=1e-10, abs_tol=1e-300):
+            failures.append(f"{label}: G {g1!r} vs {g2!r}")
+        if ga["regions"] != gb["regions"]:
+            failures.append(f"{label}: regions {ga['regions']} vs {gb['regions']}")
+
+
+examples = os.path.join(repo, "examples")
+nist = os.path.join(repo, "tests", "nist", "models")
+cases = [
+    (os.path.join(examples, "silverbox"), ["derivative_form.sid"]),
+    (os.path.join(examples, "silverbox"), ["integrated_once.sid", "--validate-samples", "2000"]),
+    (os.path.join(examples, "thesis-4-1"), ["system_4_1_1.sid"]),        # guards: region counts
+    (os.path.join(examples, "thesis-4-1"), ["quasi_linear.sid"]),
+    (os.path.join(examples, "thesis-4-2"), ["process.sid"]),             # two outputs
+    (os.path.join(examples, "thesis-4-2"), ["process_held.sid"]),        # a held input
+    (os.path.join(examples, "time-varying"),                             # two records
+     ["drift.sid", "--form", "integrated", "--data", "drift.csv", "--data", "jump.csv"]),
+] + [(nist, [name]) for name in sorted(os.listdir(nist)) if name.endswith(".sid")]
+
+work = tempfile.mkdtemp(prefix="sidc-mpi-")
+try:
+    for case, (directory, args) in enumerate(cases):
+        label = " ".join(args)
+        one_dir = os.path.join(work, f"{case}-1")
+        one = run([sidc, "fit", *args, "--stream-above", "0", "--out", one_dir], directory)
+        if one.returncode != 0:
+            failures.append(f"{label}: one process exit {one.returncode}: {one.stderr[-500:]}")
+            continue
+        if "processes:" in one.stdout or "MPI" in one.stdout:
+            failures.append(f"{label}: one process names processes")
+        for ranks in (2, 3):
+            many_dir = os.path.join(work, f"{case}-{ranks}")
+            many = run([mpiexec, "-np", str(ranks), sidc, "fit", *args, "--stream-above", "0", "--out", many_dir], directory)
+            tag = f"{label} (-np {ranks})"
+            if many.returncode != 0:
+                failures.append(f"{tag}: exit {many.returncode}: {many.stderr[-800:]}")
+                continue
+            if f"processes: {ranks} MPI ranks" not in many.stdout:
+                failures.append(f"{tag}: no line naming the {ranks} processes")
+            if many.stdout.count("sidc fit: model") != 1:
+                failures.append(f"{tag}: {many.stdout.count('sidc fit: model')} reports on stdout, expected one")
+            if "streamed QR over" in one.stdout and f"on {ranks} processes (MPI ranks)" not in many.stdout:
+                failures.append(f"{tag}: the streamed group does not say its rows were shared")
+            if normalised(one.stdout) != normalised(many.stdout):
+                diff = [f"  {x!r}\n  {y!r}" for x, y in zip(normalised(one.stdout).splitlines(), normalised(many.stdout).splitlines()) if x != y]
+                failures.append(f"{tag}: reports differ:\n" + "\n".join(diff[:5]))
+            compare_json(os.path.join(one_dir, "fit.json"), os.path.join(many_dir, "fit.json"), tag)
+        print(f"checked: {label}", flush=True)
+
+    # Faults. Rank 1 runs in a copy of the example whose record has a broken cell in y on line 41.
+    good = os.path.join(work, "good")
+    bad = os.path.join(work, "bad")
+    shutil.copytree(os.path.join(examples, "thesis-4-1"), good)
+    shutil.copytree(os.path.join(examples, "thesis-4-1"), bad)
+    with open(os.path.join(bad, "appendix_a.csv")) as f:
+        lines = f.read().splitlines(keepends=True)
+    fields = lines[40].split(",")
+    fields[1] = "oops"  # y, an output
+    lines[40] = ",".join(fields)
+    with open(os.path.join(bad, "appendix_a.csv"), "w") as f:
+        f.writelines(lines)
+    out = os.path.join(work, "fault-out")
+    fault = run([mpiexec, "-np", "1", "--wdir", good, sidc, "fit", "system_4_1_1.sid", "--stream-above", "0", "--out", out, ":",
+                 "-np", "1", "--wdir", bad, sidc, "fit", "system_4_1_1.sid", "--stream-above", "0", "--out", out], good)
+    if fault.returncode != 1:
+        failures.append(f"fault: exit {fault.returncode}, expected 1: {fault.stderr[-800:]}")
+    if "[rank 1]" not in fault.stderr or "appendix_a.csv:41:" not in fault.stderr:
+        failures.append(f"fault: rank 1's error (file:row:column) not shown: {fault.stderr[-800:]}")
+    if "rank 1 of the 2 MPI processes stopped" not in fault.stderr:
+        failures.append(f"fault: rank 0 does not say the job stopped for rank 1: {fault.stderr[-800:]}")
+    if os.path.exists(out):
+        failures.append("fault: an output directory was written although a rank failed")
+    # Every rank meets the same error: printed once.
+    same = run([mpiexec, "-np", "2", sidc, "fit", "system_4_1_1.sid", "--stream-above", "0"], bad)
+    if same.returncode != 1 or same.stderr.count("appendix_a.csv:41:") != 1 or "[rank" in same.stderr:
+        failures.append(f"same fault on every rank: exit {same.returncode}, stderr {same.stderr[-800:]!r}")
+    # A command other than fit under mpirun: rank 0 alone does it (one output, not two).
+    compiled = run([mpiexec, "-np", "2", sidc, "compile", "system_4_1_1.sid"], good)
+    if compiled.returncode != 0 or compiled.stdout.count("# system_4_1_1.sid:") != 1:
+        failures.append(f"compile under mpirun: exit {compiled.returncode}, stdout {compiled.stdout!r}")
+finally:
+    shutil.rmtree(work, ignore_errors=True)
+
+for f in failures:
+    print("FAIL:", f)
+print(f"{len(cases)} cases x (2, 3) ranks; {len(failures)} failure(s)")
+sys.exit(1 if failures else 0)

@@ -1,0 +1,208 @@
+// A streamed fit's rows shared among parts (runtime/solve/row_share.hpp, FitOptions::share): the
+// parts here are threads of this process that merge their factors through memory, which is what
+// distributed/'s MPI share does between processes (tests/distributed/ runs that one under mpirun).
+// Every part must end with the fit one process makes: the same estimates to rounding, the same
+// rows, regions and records; and a problem met in one part's rows must be named by every part as
+// one process names it. The accumulator's state must travel exactly.
+#include <gtest/gtest.h>
+
+#include <barrier>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include "runtime/solve/fit.hpp"
+#include "runtime/solve/row_share.hpp"
+#include "runtime/solve/triangular_accumulator.hpp"
+
+#include "support/shell.hpp"
+#include "support/thesis_record.hpp"
+
+namespace sidc {
+namespace {
+
+// The parts' meeting room: each part leaves its state, all wait, each merges all states in part
+// order (so every part computes the same bits), all wait again before the room is reused.
+struct ThreadRoom {
+  explicit ThreadRoom(int n) : parts(n), barrier(n), states(static_cast<std::size_t>(n)), counts(static_cast<std::size_t>(n)),
+                               problems(static_cast<std::size_t>(n)) {}
+  int parts;
+  std::barrier<> barrier;
+  std::vector<std::vector<double>> states, counts;
+  std::vector<char> problems;
+  int problem_rounds = 0;  // combines that found a problem in some part's rows (counted by part 0)
+};
+
+class ThreadShare final : public RowShare {
+ public:
+  ThreadShare(ThreadRoom& room, int part) : room_(room), part_(part) {}
+  int part() const override { return part_; }
+  int parts() const override { return room_.parts; }
+  Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem) override {
+    const auto me = static_cast<std::size_t>(part_);
+    room_.states[me] = accumulator.to_doubles();
+    room_.counts[me] = counts;
+    room_.problems[me] = has_problem ? 1 : 0;
+    room_.barrier.arrive_and_wait();
+    Combined result;
+    if (std::any_of(room_.problems.begin(), room_.problems.end(), [](char p) { return p != 0; })) {
+      result.outcome = Outcome::problem;
+      if (part_ == 0) ++room_.problem_rounds;
+    } else {
+      TriangularAccumulator merged(accumulator.columns()), other(accumulator.columns());
+      EXPECT_TRUE(merged.from_doubles(room_.states[0]));
+      std::vector<double> sums = room_.counts[0];
+      for (std::size_t k = 1; k < room_.states.size(); ++k) {
+        EXPECT_TRUE(other.from_doubles(room_.states[k]));
+        merged.merge(other);
+        for (std::size_t j = 0; j < sums.size(); ++j) sums[j] += room_.counts[k][j];
+      }
+      accumulator = merged;
+      counts = sums;
+    }
+    room_.barrier.arrive_and_wait();
+    return result;
+  }
+
+ private:
+  ThreadRoom& room_;
+  int part_;
+};
+
+std::variant<FitSummary, Diagnostic> fit_in_parts_part(const ir::Model& m, const std::vector<SampledRecord>& records, FitOptions o,
+                                                       ThreadShare& share) {
+  o.share = &share;
+  return fit(m, records, o);
+}
+
+// Every part's result, the parts running side by side as threads.
+std::vector<std::variant<FitSummary, Diagnostic>> fit_in_parts(const ir::Model& m, const std::vector<SampledRecord>& records,
+                                                               const FitOptions& o, int parts, int* problem_rounds = nullptr) {
+  ThreadRoom room(parts);
+  std::vector<ThreadShare> shares;
+  for (int k = 0; k < parts; ++k) shares.emplace_back(room, k);
+  std::vector<std::variant<FitSummary, Diagnostic>> results(static_cast<std::size_t>(parts));
+  std::vector<std::thread> threads;
+  for (int k = 0; k < parts; ++k)
+    threads.emplace_back([&, k] { results[static_cast<std::size_t>(k)] = fit_in_parts_part(m, records, o, shares[static_cast<std::size_t>(k)]); });
+  for (auto& t : threads) t.join();
+  if (problem_rounds) *problem_rounds = room.problem_rounds;
+  return results;
+}
+
+FitOptions streamed_in_blocks(std::size_t block_rows) {
+  FitOptions o;
+  o.to = 0.82;  // the thesis models' `set to`
+  o.stream_above_entries = 0;
+  o.stream_block_rows = block_rows;
+  o.stream_threads = 1;
+  o.stream_stretch_rows = 3 * block_rows + 1;  // integrals carried over many stretches
+  return o;
+}
+
+void expect_same_as_one_process(const FitSummary& one, const FitSummary& part) {
+  ASSERT_EQ(one.groups.size(), part.groups.size());
+  for (std::size_t gi = 0; gi < one.groups.size(); ++gi) {
+    const GroupFit& a = one.groups[gi];
+    const GroupFit& b = part.groups[gi];
+    EXPECT_EQ(a.summary.n, b.summary.n);
+    EXPECT_EQ(a.summary.rank, b.summary.rank);
+    ASSERT_EQ(a.regions.size(), b.regions.size());
+    for (std::size_t k = 0; k < a.regions.size(); ++k) {
+      EXPECT_EQ(a.regions[k].guards, b.regions[k].guards);
+      EXPECT_EQ(a.regions[k].rows, b.regions[k].rows);
+    }
+    ASSERT_EQ(a.records.size(), b.records.size());
+    for (std::size_t k = 0; k < a.records.size(); ++k) EXPECT_EQ(a.records[k].rows, b.records[k].rows);
+    EXPECT_NEAR(a.summary.G, b.summary.G, 1e-9 * a.summary.G);
+    ASSERT_EQ(a.summary.parameters.size(), b.summary.parameters.size());
+    for (std::size_t k = 0; k < a.summary.parameters.size(); ++k) {
+      const auto& x = a.summary.parameters[k];
+      const auto& y = b.summary.parameters[k];
+      // Another order of Householder merges: rounding, amplified by the condition number.
+      EXPECT_NEAR(x.value, y.value, 1e-9 * std::abs(x.value) + 1e-6 * x.standard_error) << x.name;
+      EXPECT_NEAR(x.standard_error, y.standard_error, 1e-6 * x.standard_error) << x.name;
+    }
+  }
+}
+
+void expect_parts_agree(const ir::Model& m, const std::vector<SampledRecord>& records, const FitOptions& o) {
+  auto single = fit(m, records, o);
+  ASSERT_TRUE(std::holds_alternative<FitSummary>(single)) << render(std::get<Diagnostic>(single));
+  const FitSummary& one = std::get<FitSummary>(single);
+  for (int parts : {2, 3, 5}) {
+    SCOPED_TRACE(parts);
+    const auto results = fit_in_parts(m, records, o, parts);
+    for (const auto& r : results) {
+      ASSERT_TRUE(std::holds_alternative<FitSummary>(r)) << render(std::get<Diagnostic>(r));
+      expect_same_as_one_process(one, std::get<FitSummary>(r));
+      EXPECT_NE(std::get<FitSummary>(r).groups[0].streamed.find(std::to_string(parts) + " processes"), std::string::npos);
+    }
+    // The parts among themselves: the same bits.
+    for (std::size_t k = 1; k < results.size(); ++k)
+      for (std::size_t j = 0; j < one.groups[0].summary.parameters.size(); ++j)
+        EXPECT_EQ(std::get<FitSummary>(results[0]).groups[0].summary.parameters[j].value,
+                  std::get<FitSummary>(results[k]).groups[0].summary.parameters[j].value);
+  }
+}
+
+TEST(RowShare, AccumulatorStateTravelsExactly) {
+  std::mt19937_64 random(7);
+  std::normal_distribution<double> normal;
+  TriangularAccumulator a(4);
+  Eigen::MatrixXd rows(300, 4);
+  Eigen::VectorXd b(300), w(300);
+  for (int i = 0; i < 300; ++i) {
+    for (int j = 0; j < 4; ++j) rows(i, j) = normal(random) * std::pow(10.0, j);
+    b(i) = normal(random);
+    w(i) = 0.5 + std::abs(normal(random));
+  }
+  rows.col(2).setConstant(3.0);  // a constant column: its mark travels too
+  ASSERT_TRUE(a.add_rows(rows, b, &w));
+  TriangularAccumulator copy(4);
+  ASSERT_TRUE(copy.from_doubles(a.to_doubles()));
+  EXPECT_EQ(copy.to_doubles(), a.to_doubles());
+  const std::vector<std::string> names{"a", "b", "c", "d"};
+  const LeastSquaresSummary x = a.solve(names, {}), y = copy.solve(names, {});
+  ASSERT_EQ(x.parameters.size(), y.parameters.size());
+  for (std::size_t k = 0; k < x.parameters.size(); ++k) EXPECT_EQ(x.parameters[k].value, y.parameters[k].value);
+  EXPECT_EQ(x.r_squared_centred, y.r_squared_centred);
+  EXPECT_EQ(x.n, y.n);
+  // The wrong size is refused, not read.
+  TriangularAccumulator other(3);
+  std::string why;
+  EXPECT_FALSE(other.from_doubles(a.to_doubles(), &why));
+  EXPECT_FALSE(why.empty());
+}
+
+TEST(RowShare, DerivativeFormWithGuardsAsOneProcessFitsIt) {
+  const ir::Model m = testing::compiled_text("d.sid", testing::read_text(SIDC_SOURCE_DIR "/examples/thesis-4-1/derivative_form.sid"));
+  expect_parts_agree(m, {testing::appendix_a(m)}, streamed_in_blocks(5));
+}
+
+TEST(RowShare, IntegratedFormOverTwoRecordsAsOneProcessFitsIt) {
+  const ir::Model m = testing::compiled_text("q.sid", testing::read_text(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid"));
+  expect_parts_agree(m, {testing::appendix_a(m), testing::appendix_a(m, 2)}, streamed_in_blocks(4));
+}
+
+// A value that cannot be evaluated in the last part's rows only: every part names the problem one
+// process names (the same text), none a problem of its own share.
+TEST(RowShare, AProblemInOnePartIsNamedAsOneProcessNamesIt) {
+  const ir::Model m = testing::compiled_text("d.sid", testing::read_text(SIDC_SOURCE_DIR "/examples/thesis-4-1/derivative_form.sid"));
+  SampledRecord r = testing::appendix_a(m);
+  auto& y = r.signals.at("y").owned();
+  y[y.size() * 3 / 4] = std::nan("");
+  const FitOptions o = streamed_in_blocks(5);
+  auto single = fit(m, {r}, o);
+  ASSERT_TRUE(std::holds_alternative<Diagnostic>(single));
+  int problem_rounds = 0;
+  const auto results = fit_in_parts(m, {r}, o, 3, &problem_rounds);
+  EXPECT_EQ(problem_rounds, 1) << "the problem was to be met in a part's rows, not before the rows were shared";
+  for (const auto& result : results) {
+    ASSERT_TRUE(std::holds_alternative<Diagnostic>(result));
+    EXPECT_EQ(render(std::get<Diagnostic>(result)), render(std::get<Diagnostic>(single)));
+  }
+}
+
+}  // namespace
+}  // namespace sidc

@@ -1,6 +1,8 @@
 // distributed/session.hpp: the processes of one command, over MPI when sidc was built with it.
 #include "distributed/session.hpp"
 
+#include "runtime/parallel_ranges.hpp"
+
 #include <fmt/format.h>
 #include <algorithm>
 #include <cstdio>
@@ -28,6 +30,7 @@ bool launched_as_rank() {
     if (std::getenv(name)) return true;
   return false;
 }
+
 
 }  // namespace
 
@@ -70,6 +73,15 @@ struct Session::Share final : RowShare {
     return {Outcome::combined, {}};
   }
 
+  Combined sum(std::span<double> values, bool has_problem) override {
+    session.exchange(has_problem ? working_with_problem : working);
+    if (session.someone_left_) return {Outcome::stopped, session.who_left()};
+    if (std::any_of(session.last_statuses_.begin(), session.last_statuses_.end(), [](int s) { return s == working_with_problem; }))
+      return {Outcome::problem, {}};
+    MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    return {Outcome::combined, {}};
+  }
+
   Session& session;
 };
 
@@ -89,7 +101,10 @@ Session& Session::start(int& argc, char**& argv) {
   int on_node = 1;
   MPI_Comm_size(node, &on_node);
   MPI_Comm_free(&node);
-  session->threads_per_rank_ = static_cast<int>(std::max(1u, cores / static_cast<unsigned>(std::max(on_node, 1))));
+  // The node's cores divided among its ranks, and never more than this rank may run on: mpirun binds
+  // each rank to one core by default when it starts at most two (`--bind-to none` frees them).
+  const unsigned share = std::max(1u, cores / static_cast<unsigned>(std::max(on_node, 1)));
+  session->threads_per_rank_ = std::min(static_cast<int>(share), core_count());  // core_count: the affinity mask's
   if (session->size_ > 1) session->share_ = new Share(*session);
   if (session->rank_ > 0) {
     // Nothing on stdout; stderr held in an unnamed file until finish() decides whether to show it.
@@ -203,8 +218,8 @@ std::string Session::who_left() const {
 
 std::string Session::processes_line() const {
   if (size_ <= 1) return {};
-  return fmt::format("processes: {} MPI ranks of {} thread{} each; the rows of every streamed group are shared among them, "
-                     "smaller groups are fitted whole by each (docs/distributed.md)",
+  return fmt::format("processes: {} MPI ranks of {} thread{} each; they share the rows of every streamed group and the weak "
+                     "form's integrals, and each fits smaller groups whole (docs/distributed.md)",
                      size_, threads_per_rank_, threads_per_rank_ == 1 ? "" : "s");
 }
 

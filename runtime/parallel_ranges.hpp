@@ -8,14 +8,22 @@
 #include <algorithm>
 #include <cstddef>
 #include <exception>
+#include <sched.h>
 #include <thread>
 #include <vector>
 
 namespace sidc {
 
-// Threads for work split over the cores: one per core, at most 8 (the streamed fit's, the local
-// fits' and these ranges' default).
-inline int core_count() { return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)); }
+// Threads for work split over the cores: one per core this process may run on (its affinity mask:
+// `taskset`, or mpirun binding a rank to its cores), at most 8 (the streamed fit's, the local fits'
+// and these ranges' default).
+inline int core_count() {
+  int cores = static_cast<int>(std::thread::hardware_concurrency());
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) == 0) cores = CPU_COUNT(&allowed);
+  return std::clamp(cores, 1, 8);
+}
 
 // f(first, last) for ranges covering [0, n); `work` is n times the cost of one element, in
 // multiply-adds, say.

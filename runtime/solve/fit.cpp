@@ -413,7 +413,7 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
                                          const std::vector<OperatorReport>& operators, GroupFit& g) {
   auto expression = expression_weights_by_record(model, evaluators);
   if (auto* d = std::get_if<Diagnostic>(&expression)) return *d;
-  auto made = weak_design(model, records, evaluators, design, g.equations, std::get<std::vector<std::vector<double>>>(expression));
+  auto made = weak_design(model, records, evaluators, design, g.equations, std::get<std::vector<std::vector<double>>>(expression), options.share);
   if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
   WeakDesign& w = std::get<WeakDesign>(made);
   for (std::size_t r = 0; r < records.size(); ++r) {

@@ -5,8 +5,9 @@
 // Relies on: triangular_accumulator.hpp (the factor and its exact state as doubles). The runtime
 // knows nothing of how the parts talk: distributed/mpi_row_share.hpp implements this over MPI.
 // Guarantees (of every implementation):
-// - combine() is collective: every part calls it the same number of times, in the same order, with
-//   counts of the same length (runtime/solve/fit.cpp calls it once per streamed group).
+// - combine() and sum() are collective: every part calls them the same number of times, in the same
+//   order, with vectors of the same length (runtime/solve/fit.cpp calls combine once per streamed
+//   group, weak_design.cpp sum once per operation and order of the test function).
 // - On `combined`, every part holds the same factor (of all parts' rows, up to rounding: the merge
 //   order is fixed, so every run with the same number of parts gives the same bits) and the same
 //   element-wise sums of `counts`.
@@ -17,6 +18,7 @@
 //   `why` says which, and the caller stops with it.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,10 @@ class RowShare {
     std::string why;  // for `stopped`
   };
   virtual Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem) = 0;
+  // Element-wise sums of `values` over the parts, on every part (weak_design.cpp: each subdomain's
+  // integral computed by one part, zeros from the others, so the sums are exact). Collective, and
+  // `has_problem` and the outcomes as for combine.
+  virtual Combined sum(std::span<double> values, bool has_problem) = 0;
 
   // Rows [first, last) of `total` that part `k` of `parts` folds: contiguous, in order, as even as
   // whole blocks of `block_rows` allow.

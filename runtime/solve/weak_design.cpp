@@ -94,9 +94,31 @@ std::variant<bool, Diagnostic> is_weak_group(const ir::Model& model, const std::
   return diag::weak_form_mixed(model.equations[strong].span);
 }
 
-WeakValues::WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid) : evaluator_(evaluator), grid_(grid) {}
+WeakValues::WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid, RowShare* share)
+    : evaluator_(evaluator), grid_(grid), share_(share && share->parts() > 1 ? share : nullptr) {}
 
-std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out) {
+namespace {
+// Window samples per block of WeakValues::add_rows.
+constexpr std::size_t kWeakBlock = std::size_t{1} << 15;
+}  // namespace
+
+std::optional<Diagnostic> WeakValues::add_shared_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w,
+                                                      std::span<double> out) {
+  const std::size_t blocks = (evaluator_.window().size() + kWeakBlock - 1) / kWeakBlock;
+  const auto [first, last] = RowShare::share_of(blocks, 1, share_->part(), share_->parts());
+  std::vector<double> mine(out.size(), 0.0);
+  const std::optional<Diagnostic> problem = add_rows(g, what, w, mine, first, last);
+  const RowShare::Combined summed = share_->sum(mine, problem.has_value());
+  if (summed.outcome == RowShare::Outcome::stopped) return diag::error("stopped", {}, summed.why);
+  // A problem in some part's rows: every part integrates all rows, and so names the first problem
+  // in the record's order, as one process does.
+  if (summed.outcome == RowShare::Outcome::problem) return add_rows(g, what, w, out);
+  for (std::size_t j = 0; j < out.size(); ++j) out[j] += mine[j];  // x + 0 + ... + 0: one part's value exactly
+  return std::nullopt;
+}
+
+std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out,
+                                               std::size_t first_block, std::size_t last_block) {
   const FitWindow& window = evaluator_.window();
   const SampledRecord& record = evaluator_.record();
   const std::size_t n = window.size(), m = grid_.half_width, count = std::min(grid_.centres.size(), out.size());
@@ -107,14 +129,18 @@ std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::stri
   // in, and g is evaluated on the block and the 2m samples after it. A value that is not finite is
   // looked for on the block's own samples, and the first by term, then sample, is the one
   // Evaluator::evaluate_in_window names.
-  constexpr std::size_t kBlock = std::size_t{1} << 15;
+  constexpr std::size_t kBlock = kWeakBlock;
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  first_block = std::min(first_block, blocks);
+  last_block = std::clamp(last_block, first_block, blocks);
   std::mutex found;
   std::optional<NonFiniteValue> first_bad;
   std::optional<Diagnostic> structural;  // a problem that is not a value (the same on every block)
   // Each row is its own dot product: the blocks split over the cores (at 10^7 samples, 8
   // subdomains cover each sample: about 8 * 10^7 products per column, the weak fit's largest cost).
-  for_parallel_ranges(blocks, n * w.size(), [&](std::size_t b0, std::size_t b1) {
+  for_parallel_ranges(last_block - first_block, std::min(n, (last_block - first_block) * kBlock) * w.size(), [&](std::size_t b0, std::size_t b1) {
+    b0 += first_block;
+    b1 += first_block;
     BlockEvaluator evaluator(record, evaluator_.options(), window, whole);
     std::vector<double> values;
     for (std::size_t b = b0; b < b1; ++b) {
@@ -152,7 +178,7 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
     auto& w = weights_[static_cast<std::size_t>(k)];
     if (w.empty()) w = test_function_weights(grid_, k, evaluator_.record().step);
     if (!evaluator_.segmented()) {
-      if (auto problem = add_rows(g_k, what, w, out)) return problem;
+      if (auto problem = share_ ? add_shared_rows(g_k, what, w, out) : add_rows(g_k, what, w, out)) return problem;
       if (auto problem = add_switch_corrections(evaluator_, grid_, g_k, w, out)) return problem;
       continue;
     }
@@ -184,7 +210,8 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
 
 std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, const std::vector<SampledRecord>& records, std::size_t r,
                                                         Evaluator& evaluator, const DesignBuilder& design,
-                                                        const std::vector<std::size_t>& equations, std::span<const double> expression) {
+                                                        const std::vector<std::size_t>& equations, std::span<const double> expression,
+                                                        RowShare* share) {
   WeakDesign out;
   std::variant<TestFunctionGrid, Diagnostic> chosen = Diagnostic{};
   {
@@ -239,7 +266,7 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
       row_weight(j) = masked ? 0.0 : s / total_phi;
     }
   }
-  WeakValues weak(evaluator, grid);
+  WeakValues weak(evaluator, grid, share);
   Eigen::Index row = 0;
   for (std::size_t e : equations) {
     if (auto problem = design.equation_rows(r, e, weak, {out.A.middleRows(row, K), out.b.segment(row, K)})) return *problem;
@@ -257,12 +284,12 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
 std::variant<WeakDesign, Diagnostic> weak_design(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                  std::vector<Evaluator>& evaluators, const DesignBuilder& design,
                                                  const std::vector<std::size_t>& equations,
-                                                 const std::vector<std::vector<double>>& expression_weights) {
+                                                 const std::vector<std::vector<double>>& expression_weights, RowShare* share) {
   std::vector<WeakDesign> parts;
   Eigen::Index total = 0;
   for (std::size_t r = 0; r < records.size(); ++r) {
     const std::span<const double> expression = r < expression_weights.size() ? std::span<const double>(expression_weights[r]) : std::span<const double>();
-    auto part = weak_record_design(model, records, r, evaluators[r], design, equations, expression);
+    auto part = weak_record_design(model, records, r, evaluators[r], design, equations, expression, share);
     if (auto* d = std::get_if<Diagnostic>(&part)) return *d;
     parts.push_back(std::get<WeakDesign>(std::move(part)));
     total += parts.back().b.size();

@@ -24,6 +24,7 @@
 #include "runtime/operators/evaluate.hpp"
 #include "runtime/operators/test_functions.hpp"
 #include "runtime/solve/design.hpp"
+#include "runtime/solve/row_share.hpp"
 
 namespace sidc {
 
@@ -44,18 +45,26 @@ double support_dot(const std::vector<double>& w, const double* x);
 // Row j of an operation: its integral against subdomain j's test function (see above).
 class WeakValues final : public DesignValues {
  public:
-  WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid);
+  // With a share of more than one part (FitOptions::share), each part integrates the subdomains
+  // whose supports start in its share of the window's blocks, and the parts' rows are summed
+  // (row_share.hpp): the rows one process computes, bit for bit.
+  WeakValues(Evaluator& evaluator, const TestFunctionGrid& grid, RowShare* share = nullptr);
   std::optional<Diagnostic> evaluate(const ir::Sum& sum, std::size_t index, const std::string& what,
                                      std::span<double> out) override;
 
  private:
   // out[j] += integral(phi_j^(k) g) for every row, g evaluated block by block (block_evaluator.hpp:
   // Evaluator's values bit for bit) on the blocks' threads: memory of a block, not of the window.
-  std::optional<Diagnostic> add_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out);
+  // Only the rows whose supports start in window blocks [first_block, last_block).
+  std::optional<Diagnostic> add_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out,
+                                     std::size_t first_block = 0, std::size_t last_block = SIZE_MAX);
+  // add_rows with the blocks shared among share_'s parts.
+  std::optional<Diagnostic> add_shared_rows(const ir::Sum& g, const std::string& what, const std::vector<double>& w, std::span<double> out);
 
   Evaluator& evaluator_;
   const TestFunctionGrid& grid_;
   std::vector<std::vector<double>> weights_;  // per derivative order of phi, made when first asked for
+  RowShare* share_ = nullptr;
 };
 
 struct WeakDesign {
@@ -70,14 +79,15 @@ struct WeakDesign {
 // `expression` is `set weights` on the window as fit.cpp computes it (empty when the model sets none).
 std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, const std::vector<SampledRecord>& records, std::size_t r,
                                                         Evaluator& evaluator, const DesignBuilder& design,
-                                                        const std::vector<std::size_t>& equations, std::span<const double> expression);
+                                                        const std::vector<std::size_t>& equations, std::span<const double> expression,
+                                                        RowShare* share = nullptr);
 
 // The weak design of `design`'s group over every record (each evaluator on its record's window),
 // the records' rows stacked; `expression_weights` per record (empty when the model sets none).
 std::variant<WeakDesign, Diagnostic> weak_design(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                  std::vector<Evaluator>& evaluators, const DesignBuilder& design,
                                                  const std::vector<std::size_t>& equations,
-                                                 const std::vector<std::vector<double>>& expression_weights);
+                                                 const std::vector<std::vector<double>>& expression_weights, RowShare* share = nullptr);
 
 // One line for the report: "42 subdomains of 2*48+1 samples, phi = (1 - s^2)^6; <reason>".
 std::string describe(const TestFunctionGrid& grid, double step);

@@ -77,6 +77,8 @@ cases = [
     (os.path.join(examples, "thesis-4-1"), ["quasi_linear.sid"]),
     (os.path.join(examples, "thesis-4-2"), ["process.sid"]),             # two outputs
     (os.path.join(examples, "thesis-4-2"), ["process_held.sid"]),        # a held input
+    (os.path.join(examples, "noisy-duffing"), ["duffing.sid"]),          # the form chosen: weak, with its shared integrals
+    (os.path.join(examples, "pendulum-length"), ["pendulum.sid"]),       # a nonlinear parameter: many fits, each collective
     (os.path.join(examples, "time-varying"),                             # two records
      ["drift.sid", "--form", "integrated", "--data", "drift.csv", "--data", "jump.csv"]),
 ] + [(nist, [name]) for name in sorted(os.listdir(nist)) if name.endswith(".sid")]

@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""Issue 17's measurement: `sidc fit` as one process and as N MPI ranks on the same long record.
+
+The record and the 20-term models are bench/streaming's (fit_bench's forced Duffing-van der Pol
+oscillator, generated once into --dir). For each form (derivative, weak; --no-validate, so that the
+fit itself is timed) the commands run in rounds, one of each per round in turn (A/B pairs on a
+shared machine): `sidc fit` alone, and `mpirun -np N sidc fit` for each N of --ranks (oversubscribed
+where N exceeds the cores). Wall time is a monotonic clock around the child; peak memory is the
+largest resident set among the job's processes (wait4's ru_maxrss covers the child and its reaped
+descendants). Medians with min-max are printed, and each report is compared with the single
+process's apart from the lines naming processes and threads: where printed digits differ (estimates
+at rounding level, true zeros of the benchmark's library), the largest difference of an estimate
+relative to the largest estimate is printed (issue 17 asks for 1e-12).
+
+Python standard library only. Usage (bench/README.md, "Distributed"):
+    python3 bench/distributed/run.py --sidc build/cli/sidc --fit-bench build/bench/fit_bench [--rows 1e7] [--ranks 1,2,4]
+"""
+import argparse
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "streaming"))
+from run import FORMS, MODEL  # noqa: E402  (bench/streaming/run.py: the same models)
+
+
+def run_once(command, cwd):
+    with open(os.path.join(cwd, "last.out"), "wb") as out, open(os.path.join(cwd, "last.err"), "wb") as err:
+        start = time.monotonic()
+        child = subprocess.Popen(command, cwd=cwd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+        _, status, usage = os.wait4(child.pid, 0)
+        wall = time.monotonic() - start
+    code = os.waitstatus_to_exitcode(status)
+    with open(os.path.join(cwd, "last.out"), errors="replace") as f:
+        report = f.read()
+    return wall, usage.ru_maxrss / 1024.0, code, report
+
+
+PARAMETER = re.compile(r"^  (\S+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+\[")
+
+
+def estimates(report):
+    """Each parameter's printed estimate, by name (the fit report's table)."""
+    return {m.group(1): float(m.group(2)) for m in map(PARAMETER.match, report.splitlines()) if m}
+
+
+def difference(reference, report):
+    """None when the reports agree line by line (but for the lines naming processes and threads);
+    else the largest difference of a printed estimate, relative to the largest estimate."""
+    keep = lambda r: [x for x in r.splitlines() if not x.startswith("processes: ") and "streamed QR over" not in x]
+    if keep(reference) == keep(report):
+        return None
+    a, b = estimates(reference), estimates(report)
+    if a.keys() != b.keys() or not a:
+        return float("inf")
+    scale = max(abs(v) for v in a.values()) or 1.0
+    return max(abs(a[k] - b[k]) for k in a) / scale
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sidc", required=True)
+    parser.add_argument("--fit-bench", required=True)
+    parser.add_argument("--mpirun", default=shutil.which("mpirun") or "mpirun")
+    parser.add_argument("--rows", default="1e7")
+    parser.add_argument("--ranks", default="1,2,4")
+    parser.add_argument("--forms", default="derivative,weak")
+    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--dir", default="/tmp/sidc-bench-distributed")
+    a = parser.parse_args()
+    rows = int(float(a.rows))
+    ranks = [int(r) for r in a.ranks.split(",")]
+    os.makedirs(a.dir, exist_ok=True)
+    csv = f"fit-{rows}.csv"
+    if not os.path.exists(os.path.join(a.dir, csv)):
+        print(f"generating {csv} ...", flush=True)
+        subprocess.run([os.path.abspath(a.fit_bench), "--rows", str(rows), "--keep", "--skip-library", "--skip-cli", "--dir", a.dir],
+                       check=True, stdout=subprocess.DEVNULL)
+    env_note = "OMPI_ALLOW_RUN_AS_ROOT" if os.geteuid() == 0 else None
+    if env_note:  # mpirun refuses root unless told; the bench runs as root on CI-like machines
+        os.environ.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    sidc = os.path.abspath(a.sidc)
+    print(f"record {csv}: {rows} rows; {os.cpu_count()} cores; {a.runs} rounds; medians (min-max)")
+    print(f"{'form':<11} {'processes':<26} {'wall s':>22} {'peak MiB (largest process)':>28}")
+    for form in a.forms.split(","):
+        with open(os.path.join(a.dir, f"{form}.sid"), "w") as f:
+            f.write(MODEL.format(form=form, csv=csv, setting=FORMS[form]))
+        commands = [("sidc fit (one process)", [sidc, "fit", f"{form}.sid", "--no-validate"])]
+        for n in ranks:
+            commands.append((f"mpirun -np {n}", [a.mpirun, "--oversubscribe", "-np", str(n), sidc, "fit", f"{form}.sid", "--no-validate"]))
+        walls = {name: [] for name, _ in commands}
+        peaks = {name: [] for name, _ in commands}
+        reference, failures, differences = None, [], {}
+        for _ in range(a.runs):
+            for name, command in commands:
+                wall, peak, code, report = run_once(command, a.dir)
+                if code != 0:
+                    failures.append(f"{name}: exit {code}")
+                    continue
+                if reference is None:
+                    reference = report
+                else:
+                    d = difference(reference, report)
+                    if d is not None:
+                        differences[name] = max(differences.get(name, 0.0), d)
+                walls[name].append(wall)
+                peaks[name].append(peak)
+        for name, _ in commands:
+            w, p = walls[name], peaks[name]
+            if not w:
+                print(f"{form:<11} {name:<26} {'failed':>22}")
+                continue
+            print(f"{form:<11} {name:<26} {statistics.median(w):>8.2f} ({min(w):.2f}-{max(w):.2f})"
+                  f" {statistics.median(p):>12.0f} ({min(p):.0f}-{max(p):.0f})")
+        for name, d in differences.items():
+            print(f"  {name}: the report differs from one process's in printed digits; largest estimate difference "
+                  f"{d:.1e} of the largest estimate" + ("  <-- TOO LARGE" if d > 1e-12 else " (rounding)"))
+        for f in sorted(set(failures)):
+            print(f"  FAILED: {f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -39,9 +39,10 @@ int with_stdout_checked(int code) {
 
 int run_command(int argc, char** argv, const sidc::distributed::Session& session) {
   std::signal(SIGPIPE, SIG_IGN);
-  // Only `fit` shares its work among ranks; any other command runs on rank 0 alone, so that two
-  // ranks never write the same file.
-  if (session.size() > 1 && !session.is_writer() && (argc < 2 || std::string(argv[1]) != "fit")) return sidc::exit_code::success;
+  // Only `fit` and `select` share their work among ranks; any other command runs on rank 0 alone, so
+  // that two ranks never write the same file.
+  if (session.size() > 1 && !session.is_writer() && (argc < 2 || (std::string(argv[1]) != "fit" && std::string(argv[1]) != "select")))
+    return sidc::exit_code::success;
   CLI::App app{"sidc: identify the parameters and operations of dynamic systems from recorded data\n"
                "(the method of W. D. Bernhart, 1964). Main path: sidc compile model.sid && sidc fit"};
   app.name("sidc");  // in --help, whatever path the binary was run by

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "cli/exit_codes.hpp"
 #include "cli/number_check.hpp"
@@ -18,6 +19,7 @@
 #include "cli/record_options.hpp"
 #include "compiler/load_model.hpp"
 #include "diagnostics/cli_catalogue.hpp"
+#include "distributed/session.hpp"
 #include "driver/select_run.hpp"
 #include "report/atomic_file.hpp"
 #include "report/fit_files.hpp"
@@ -41,6 +43,7 @@ struct SelectArguments {
   std::string rule = "elbow";
   bool keep_drift = false;  // search drift absorbers of integrated equations too
   std::string out;
+  std::optional<std::size_t> stream_above;  // --stream-above ENTRIES
 };
 
 int run_select(const SelectArguments& a) {
@@ -87,6 +90,12 @@ int run_select(const SelectArguments& a) {
     }
     s.groups.push_back(std::move(group));
   }
+  // Under mpirun: the streamed rows shared among the ranks, rank 0 alone printing and writing.
+  distributed::Session& session = distributed::Session::current();
+  s.share = session.row_share();
+  s.threads = session.threads_per_rank();
+  s.stream_above = a.stream_above;
+  s.processes = session.processes_line();
   ProgressLine progress;  // on stderr, only when it is a terminal
   auto prepared = driver::prepare_select(std::move(*compiled), a.model, fs::path(a.model).parent_path().string(), record_inputs(a.records), std::move(s),
                                          [&progress](const std::string& phase, std::size_t done, std::size_t total) { progress.update(phase, done, total); });
@@ -100,7 +109,9 @@ int run_select(const SelectArguments& a) {
   }
   const driver::FitOutput print{[](const std::string& text) { std::cout << text; }, [](const std::string& line) { std::cerr << line << "\n"; }, {}};
   if (auto f = driver::run_select(run, print)) return fail(*f);
-  if (!a.out.empty()) {
+  // Every rank has selected, or the job stops here without a file written.
+  if (!session.agree(exit_code::success)) return fail(render(diag::error("stopped", {}, session.who_left())), exit_code::user_error);
+  if (!a.out.empty() && session.is_writer()) {
     auto written = write_select_file(a.out, *run.summary, a.model, run.options);
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     std::cerr << "wrote " << std::get<std::string>(written) << "\n";
@@ -132,6 +143,11 @@ void add_select_command(CLI::App& app, int& exit_status) {
       ->check(CLI::IsMember({"elbow", "aic", "bic", "cv"}));
   cmd->add_flag("--keep-drift", a->keep_drift, "Search candidates that are nearly a polynomial in t (drift absorbers) in integrated equations too");
   cmd->add_option("--out", a->out, "Directory for select.json");
+  cmd->add_option("--stream-above", a->stream_above,
+                  "Fold a record's rows into the time blocks' triangular factors block by block (memory that does not grow with the "
+                  "record) when its design has more than this many entries, rows x candidates (default 8000000; 0 = always). "
+                  "Under mpirun the ranks share the streamed rows (docs/distributed.md)")
+      ->check(whole_number_check(0));
   cmd->callback([a, &exit_status] { exit_status = run_select(*a); });
 }
 

@@ -35,41 +35,39 @@ bool launched_as_rank() {
 }  // namespace
 
 #ifdef SIDC_HAVE_MPI
-// The rows' share over MPI: a status exchange, then a binary tree of factor merges to rank 0
-// (rank r takes r + 1, r + 2, r + 4, ... in that order: the same bits on every run), and the
-// merged factor broadcast back, so that every rank goes on with the factor of all rows.
+// The rows' share over MPI: a status exchange, then a binary tree of merges to rank 0 (rank r
+// takes r + 1, r + 2, r + 4, ... in that order: the same bits on every run), and the merged state
+// broadcast back, so that every rank goes on with the state of all rows.
 struct Session::Share final : RowShare {
+  static constexpr int kMergeTag = 17;
   explicit Share(Session& s) : session(s) {}
   int part() const override { return session.rank_; }
   int parts() const override { return session.size_; }
 
-  Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem) override {
-    const std::vector<int> statuses = session.exchange(has_problem ? working_with_problem : working);
+  Combined merge(std::vector<double>& state, const Merge& merge_two, bool has_problem) override {
+    session.exchange(has_problem ? working_with_problem : working);
     if (session.someone_left_) return {Outcome::stopped, session.who_left()};
-    if (std::any_of(statuses.begin(), statuses.end(), [](int s) { return s == working_with_problem; })) return {Outcome::problem, {}};
-    std::vector<double> state = accumulator.to_doubles();
-    const std::size_t factor_size = state.size();
-    state.insert(state.end(), counts.begin(), counts.end());
-    const int length = static_cast<int>(state.size());
-    std::vector<double> theirs(state.size());
-    TriangularAccumulator other(accumulator.columns());
+    if (std::any_of(session.last_statuses_.begin(), session.last_statuses_.end(), [](int s) { return s == working_with_problem; }))
+      return {Outcome::problem, {}};
     const int rank = session.rank_, size = session.size_;
     for (int step = 1; step < size; step *= 2) {
-      if (rank % (2 * step) != 0) {  // hand this subtree's rows up and leave the tree
-        MPI_Send(state.data(), length, MPI_DOUBLE, rank - step, 17, MPI_COMM_WORLD);
+      if (rank % (2 * step) != 0) {  // hand this subtree's state up and leave the tree
+        MPI_Send(state.data(), static_cast<int>(state.size()), MPI_DOUBLE, rank - step, kMergeTag, MPI_COMM_WORLD);
         break;
       }
       if (rank + step >= size) continue;
-      MPI_Recv(theirs.data(), length, MPI_DOUBLE, rank + step, 17, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-      other.from_doubles(std::vector<double>(theirs.begin(), theirs.begin() + static_cast<std::ptrdiff_t>(factor_size)));
-      accumulator.merge(other);
-      std::vector<double> merged = accumulator.to_doubles();
-      for (std::size_t k = factor_size; k < state.size(); ++k) merged.push_back(state[k] + theirs[k]);
-      state = std::move(merged);
+      MPI_Status status;
+      MPI_Probe(rank + step, kMergeTag, MPI_COMM_WORLD, &status);
+      int length = 0;
+      MPI_Get_count(&status, MPI_DOUBLE, &length);
+      std::vector<double> right(static_cast<std::size_t>(length));
+      MPI_Recv(right.data(), length, MPI_DOUBLE, rank + step, kMergeTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      merge_two(state, right);  // the parts from rank + step on come right after this subtree's
     }
-    MPI_Bcast(state.data(), length, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-    accumulator.from_doubles(std::vector<double>(state.begin(), state.begin() + static_cast<std::ptrdiff_t>(factor_size)));
-    counts.assign(state.begin() + static_cast<std::ptrdiff_t>(factor_size), state.end());
+    long long length = static_cast<long long>(state.size());
+    MPI_Bcast(&length, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    state.resize(static_cast<std::size_t>(length));
+    MPI_Bcast(state.data(), static_cast<int>(length), MPI_DOUBLE, 0, MPI_COMM_WORLD);
     return {Outcome::combined, {}};
   }
 
@@ -218,8 +216,8 @@ std::string Session::who_left() const {
 
 std::string Session::processes_line() const {
   if (size_ <= 1) return {};
-  return fmt::format("processes: {} MPI ranks of {} thread{} each; they share the rows of every streamed group and the weak "
-                     "form's integrals, and each fits smaller groups whole (docs/distributed.md)",
+  return fmt::format("processes: {} MPI ranks of {} thread{} each; they share the rows of every streamed design and the weak "
+                     "form's integrals, and each evaluates smaller designs whole (docs/distributed.md)",
                      size_, threads_per_rank_, threads_per_rank_ == 1 ? "" : "s");
 }
 

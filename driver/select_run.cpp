@@ -68,6 +68,9 @@ std::variant<std::unique_ptr<SelectRun>, Failure> prepare_select(
   auto fit = fit_options(model, a.records);
   if (auto* d = std::get_if<Diagnostic>(&fit)) return failure(*d, true);
   o.fit = std::get<FitOptions>(fit);
+  o.fit.share = a.share;
+  if (a.stream_above) o.fit.stream_above_entries = *a.stream_above;
+  if (a.threads > 0) o.fit.stream_threads = a.threads;
   const std::map<std::string, SelectionMethod> methods{
       {"automatic", SelectionMethod::automatic}, {"exact", SelectionMethod::exact}, {"stlsq", SelectionMethod::stlsq}, {"frols", SelectionMethod::frols}};
   o.method = methods.at(a.method);
@@ -139,7 +142,8 @@ std::optional<Failure> run_select(SelectRun& run, const FitOutput& out) {
                               d.set_aside ? fmt::format("; set aside before the search (give {} or {} to search it)", option_name(a, "keep-drift"),
                                                         option_name(a, "require"))
                                           : ""));
-  out.report(fmt::format("sidc select: model `{}` ({}), size rule {}\n{}\n", model.name, run.model_path, to_string(o.rule), run.form_note) +
+  out.report(fmt::format("sidc select: model `{}` ({}), size rule {}\n{}{}\n", model.name, run.model_path, to_string(o.rule), run.form_note,
+                         a.processes.empty() ? "" : a.processes + "\n") +
              summary.report());
   return std::nullopt;
 }

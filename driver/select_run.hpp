@@ -35,6 +35,11 @@ struct SelectSettings {
   bool simulate = false, keep_drift = false;
   std::size_t simulate_samples = 100000;
   bool keywords = false;  // messages name options as keywords (`keep_drift`) rather than `--keep-drift`
+  // As FitSettings' (fit_run.hpp): the rows shared among processes, threads each, the report's line.
+  RowShare* share = nullptr;
+  int threads = 0;
+  std::string processes;
+  std::optional<std::size_t> stream_above;  // FitOptions::stream_above_entries (unset: the default)
 };
 
 struct SelectRun {

@@ -291,7 +291,7 @@ std::variant<SelectSummary, Diagnostic> select_operations(const ir::Model& model
       Eigen::MatrixXd A;
       Eigen::VectorXd b, weights;
       if (std::get<bool>(weak)) {
-        auto made = weak_record_design(model, records, r, evaluator, design, members, expression);
+        auto made = weak_record_design(model, records, r, evaluator, design, members, expression, options.fit.share);
         if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
         WeakDesign& wd = std::get<WeakDesign>(made);
         W = wd.grids.front().centres.size();

@@ -152,6 +152,40 @@ void LineShareSums::join(const LineShareSums& next) {
   count_ += next.count_;
 }
 
+// n, integrations, first, count, p, head rows, tail rows, head, tail, gram, cross, squares.
+std::vector<double> LineShareSums::to_doubles() const {
+  std::vector<double> out{static_cast<double>(n_),          static_cast<double>(integrations_),  static_cast<double>(first_),
+                          static_cast<double>(count_),      static_cast<double>(squares_.size()), static_cast<double>(head_.rows()),
+                          static_cast<double>(tail_.rows())};
+  out.insert(out.end(), head_.data(), head_.data() + head_.size());
+  out.insert(out.end(), tail_.data(), tail_.data() + tail_.size());
+  out.insert(out.end(), gram_, gram_ + 3);
+  out.insert(out.end(), cross_.data(), cross_.data() + cross_.size());
+  out.insert(out.end(), squares_.data(), squares_.data() + squares_.size());
+  return out;
+}
+
+bool LineShareSums::from_doubles(const std::vector<double>& s) {
+  if (s.size() < 7) return false;
+  const auto p = static_cast<Eigen::Index>(s[4]), head = static_cast<Eigen::Index>(s[5]), tail = static_cast<Eigen::Index>(s[6]);
+  if (p != squares_.size() || head < 0 || tail < 0 || s.size() != static_cast<std::size_t>(7 + (head + tail) * p + 3 + 3 * p)) return false;
+  n_ = static_cast<std::size_t>(s[0]);
+  integrations_ = static_cast<int>(s[1]);
+  first_ = static_cast<std::size_t>(s[2]);
+  count_ = static_cast<std::size_t>(s[3]);
+  const double* at = s.data() + 7;
+  head_ = Eigen::Map<const Eigen::MatrixXd>(at, head, p);
+  at += head * p;
+  tail_ = Eigen::Map<const Eigen::MatrixXd>(at, tail, p);
+  at += tail * p;
+  std::copy(at, at + 3, gram_);
+  at += 3;
+  cross_ = Eigen::Map<const Eigen::MatrixXd>(at, 2, p);
+  at += 2 * p;
+  squares_ = Eigen::Map<const Eigen::VectorXd>(at, p);
+  return true;
+}
+
 std::vector<double> LineShareSums::shares() const {
   std::vector<double> share(static_cast<std::size_t>(squares_.size()), std::numeric_limits<double>::quiet_NaN());
   if (n_ == 0) return share;

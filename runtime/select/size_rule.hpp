@@ -71,6 +71,10 @@ class LineShareSums {
   // Appends the piece `next`, whose rows start where this one's end.
   void join(const LineShareSums& next);
   std::vector<double> shares() const;
+  // The whole state as doubles (to merge pieces made by other processes, row_share.hpp), and back:
+  // from_doubles gives false for a state of another shape.
+  std::vector<double> to_doubles() const;
+  bool from_doubles(const std::vector<double>& state);
 
  private:
   void accumulate(std::size_t first_level0, const Eigen::Ref<const Eigen::MatrixXd>& rows);  // the I-th differences of `rows`

@@ -45,6 +45,57 @@ struct Worker {
   bool failed = false;
 };
 
+// One process's pieces of a record as one state: per triangle and per line piece, its length and
+// its own state (TriangularAccumulator and LineShareSums to_doubles).
+std::vector<double> pack_pieces(const std::vector<TriangularAccumulator>& triangles, const std::vector<LineShareSums>& lines) {
+  std::vector<double> out;
+  const auto put = [&out](const std::vector<double>& piece) {
+    out.push_back(static_cast<double>(piece.size()));
+    out.insert(out.end(), piece.begin(), piece.end());
+  };
+  for (const auto& t : triangles) put(t.to_doubles());
+  for (const auto& l : lines) put(l.to_doubles());
+  return out;
+}
+
+bool unpack_pieces(const std::vector<double>& state, std::vector<TriangularAccumulator>& triangles, std::vector<LineShareSums>& lines) {
+  std::size_t at = 0;
+  const auto get = [&](std::vector<double>& piece) {
+    if (at >= state.size()) return false;
+    const auto length = static_cast<std::size_t>(state[at++]);
+    if (length > state.size() - at) return false;
+    piece.assign(state.begin() + static_cast<std::ptrdiff_t>(at), state.begin() + static_cast<std::ptrdiff_t>(at + length));
+    at += length;
+    return true;
+  };
+  std::vector<double> piece;
+  for (auto& t : triangles)
+    if (!get(piece) || !t.from_doubles(piece)) return false;
+  for (auto& l : lines)
+    if (!get(piece) || !l.from_doubles(piece)) return false;
+  return at == state.size();
+}
+
+// The record's pieces of every process, merged (true), or some process failed (false: every
+// process then builds the record's rows whole), or the job stopped (a Diagnostic).
+std::variant<bool, Diagnostic> merge_record_pieces(RowShare& share, std::vector<TriangularAccumulator>& triangles,
+                                                   std::vector<LineShareSums>& lines, int p, bool failed) {
+  std::vector<double> state = pack_pieces(triangles, lines);
+  const std::vector<LineShareSums> shape = lines;  // the right number and shape of line pieces
+  const RowShare::Merge merge = [&](std::vector<double>& left, const std::vector<double>& right) {
+    std::vector<TriangularAccumulator> a(triangles.size(), TriangularAccumulator(p)), b = a;
+    std::vector<LineShareSums> la = shape, lb = shape;
+    if (!unpack_pieces(left, a, la) || !unpack_pieces(right, b, lb)) return;  // cannot happen: the same shapes everywhere
+    for (std::size_t k = 0; k < a.size(); ++k) a[k].merge(b[k]);
+    for (std::size_t k = 0; k < la.size(); ++k) la[k].join(lb[k]);
+    left = pack_pieces(a, la);
+  };
+  const RowShare::Combined combined = share.merge(state, merge, failed);
+  if (combined.outcome == RowShare::Outcome::stopped) return diag::error("stopped", {}, combined.why);
+  if (combined.outcome == RowShare::Outcome::problem) return false;
+  return unpack_pieces(state, triangles, lines);
+}
+
 }  // namespace
 
 std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model, const std::vector<SampledRecord>& records,
@@ -138,10 +189,21 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
     }
   };
 
+  // Shared among processes (FitOptions::share): this one folds window rows [mine_first, mine_last)
+  // only, its integrals carried from the window's start as far as its share needs them.
+  RowShare* share = options.share && options.share->parts() > 1 ? options.share : nullptr;
+  const auto [mine_first, mine_last] =
+      share ? RowShare::share_of(W, block_rows, share->part(), share->parts()) : std::pair<std::size_t, std::size_t>{0, W};
+  bool failed = false;
   const std::size_t stretch = running.stretch_rows(options.stream_stretch_rows);
-  for (std::size_t begin = 0; begin < W; begin += stretch) {
-    const std::size_t end = std::min(W, begin + stretch);
-    if (running.advance(end, threads, block_rows)) return StreamedRows::use_whole_rows;
+  for (std::size_t stretch_first = 0; stretch_first < mine_last && !failed; stretch_first += stretch) {
+    const std::size_t end = std::min(mine_last, stretch_first + stretch);
+    if (running.advance(end, threads, block_rows)) {
+      failed = true;
+      break;
+    }
+    if (end <= mine_first) continue;
+    const std::size_t begin = std::max(stretch_first, mine_first);
     const WholeWindowValues& values = running.values();
     const std::size_t chunks = (end - begin + block_rows - 1) / block_rows;
     const std::size_t parts = std::min<std::size_t>(static_cast<std::size_t>(threads), std::max<std::size_t>(chunks / 4, 1));
@@ -154,13 +216,24 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
     for (std::size_t k = 1; k < parts; ++k) pool.emplace_back([&, k] { fold_part(values, workers[k], bound(k), bound(k + 1)); });
     fold_part(values, workers[0], begin, bound(1));
     for (auto& t : pool) t.join();
-    for (std::size_t k = 0; k < parts; ++k) {
-      if (workers[k].failed) return StreamedRows::use_whole_rows;
-      for (std::size_t e = 0; e < E; ++e) lines[e].join(workers[k].lines[e]);
+    for (std::size_t k = 0; k < parts && !failed; ++k) {
+      failed = workers[k].failed;
+      for (std::size_t e = 0; e < E && !failed; ++e) lines[e].join(workers[k].lines[e]);
     }
   }
+  if (failed && !share) return StreamedRows::use_whole_rows;
+  // This record's time-block triangles, apart from `blocks` (which may hold earlier records' rows).
+  std::vector<TriangularAccumulator> mine(F, TriangularAccumulator(static_cast<int>(p)));
   for (const auto& w : workers)
-    for (std::size_t b = 0; b < F; ++b) blocks[b].merge(w.blocks[b]);
+    for (std::size_t b = 0; b < F; ++b) mine[b].merge(w.blocks[b]);
+  if (share) {
+    // Every process's triangles merged and line pieces joined in process order (each piece's rows
+    // come right after the last one's); a problem anywhere sends every process to the whole rows.
+    auto merged = merge_record_pieces(*share, mine, lines, static_cast<int>(p), failed);
+    if (auto* d = std::get_if<Diagnostic>(&merged)) return *d;
+    if (!std::get<bool>(merged)) return StreamedRows::use_whole_rows;
+  }
+  for (std::size_t b = 0; b < F; ++b) blocks[b].merge(mine[b]);
   shares.clear();
   for (const auto& l : lines) shares.push_back(l.shares());
   return StreamedRows::folded;

@@ -5,19 +5,19 @@
 // Relies on: triangular_accumulator.hpp (the factor and its exact state as doubles). The runtime
 // knows nothing of how the parts talk: distributed/mpi_row_share.hpp implements this over MPI.
 // Guarantees (of every implementation):
-// - combine() and sum() are collective: every part calls them the same number of times, in the same
-//   order, with vectors of the same length (runtime/solve/fit.cpp calls combine once per streamed
-//   group, weak_design.cpp sum once per operation and order of the test function).
-// - On `combined`, every part holds the same factor (of all parts' rows, up to rounding: the merge
-//   order is fixed, so every run with the same number of parts gives the same bits) and the same
-//   element-wise sums of `counts`.
-// - On `problem`, no factor is merged: some part met a problem in its rows (a value that is not
+// - merge(), sum() and combine() are collective: every part calls them the same number of times, in
+//   the same order (fit.cpp combines once per streamed group, weak_design.cpp sums once per
+//   operation and order of the test function, select's streamed_rows.cpp merges once per record).
+// - On `combined`, every part holds the same merged state (of all parts' rows, up to rounding: the
+//   tree is fixed, so every run with the same number of parts gives the same bits).
+// - On `problem`, nothing is merged: some part met a problem in its rows (a value that is not
 //   finite, a guard that cannot be evaluated); the caller then finds the one a single process names
 //   by evaluating every row itself.
 // - On `stopped`, another part has left the job with an error of its own (printed by that part):
 //   `why` says which, and the caller stops with it.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -37,13 +37,21 @@ class RowShare {
     Outcome outcome = Outcome::combined;
     std::string why;  // for `stopped`
   };
-  virtual Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem) = 0;
+  // `left` becomes the state of left's rows followed by right's (right's parts come right after
+  // left's, so pieces that must join in order, such as a line fit's running differences, can).
+  using Merge = std::function<void(std::vector<double>& left, const std::vector<double>& right)>;
+
+  // Every part's `state` merged in part order, by a binary tree of merge(left, right) (the same tree
+  // for the same number of parts), and the result given to every part. States may differ in length.
+  virtual Combined merge(std::vector<double>& state, const Merge& merge, bool has_problem) = 0;
   // Element-wise sums of `values` over the parts, on every part (weak_design.cpp: each subdomain's
-  // integral computed by one part, zeros from the others, so the sums are exact). Collective, and
-  // `has_problem` and the outcomes as for combine.
+  // integral computed by one part, zeros from the others, so the sums are exact).
   virtual Combined sum(std::span<double> values, bool has_problem) = 0;
 
-  // Rows [first, last) of `total` that part `k` of `parts` folds: contiguous, in order, as even as
+  // The streamed fit's merge (fit.cpp): every part's factor, and `counts` summed.
+  Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem);
+
+  // Rows [first, last) of `total` that part `k` of `parts` takes: contiguous, in order, as even as
   // whole blocks of `block_rows` allow.
   static std::pair<std::size_t, std::size_t> share_of(std::size_t total, std::size_t block_rows, int k, int parts) {
     const std::size_t blocks = (total + block_rows - 1) / block_rows;

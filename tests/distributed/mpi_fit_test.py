@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """`mpirun -np N sidc fit` against `sidc fit` (issue 17, docs/distributed.md).
 
-For every case (bundled examples, the NIST sets, a fit of two records) and N = 2 and 3 ranks
+For every case (bundled examples, the NIST sets, a fit of two records; and three selections) and
+N = 2 and 3 ranks
 (oversubscribed on a smaller machine), with every group streamed (`--stream-above 0`) so that the
 ranks really share the rows:
 - the same exit code, and the same report on stdout apart from the line naming the processes and
@@ -18,6 +19,7 @@ Usage: mpi_fit_test.py SIDC MPIEXEC REPO
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -34,13 +36,15 @@ def run(args, cwd):
 
 
 def normalised(report):
-    """The report without the line naming the processes; the "solved:" line without who folded."""
+    """The report without the line naming the processes; the "solved:" line without who folded, the
+    selection's search without its time."""
     lines = []
     for line in report.splitlines():
         if line.startswith("processes: "):
             continue
         if "streamed QR over" in line:
             line = line[: line.index(" on ")] + " on (threads or ranks)"
+        line = re.sub(r"\b[0-9.]+(e-?[0-9]+)? s\b", "(seconds)", line)  # the searches' times
         lines.append(line)
     return "\n".join(lines)
 
@@ -111,6 +115,26 @@ try:
                 diff = [f"  {x!r}\n  {y!r}" for x, y in zip(normalised(one.stdout).splitlines(), normalised(many.stdout).splitlines()) if x != y]
                 failures.append(f"{tag}: reports differ:\n" + "\n".join(diff[:5]))
             compare_json(os.path.join(one_dir, "fit.json"), os.path.join(many_dir, "fit.json"), tag)
+        print(f"checked: {label}", flush=True)
+
+    # sidc select: the time blocks' triangles and line sums merged; the same table.
+    selections = [(os.path.join(examples, "thesis-4-1"), ["select_sixth.sid"]),
+                  (os.path.join(examples, "thesis-4-1"), ["select_sixth.sid", "--method", "stlsq", "--bootstrap", "20"]),
+                  (os.path.join(examples, "silverbox"), ["derivative_form.sid", "--max-size", "4"])]
+    for directory, args in selections:
+        label = "select " + " ".join(args)
+        one = run([sidc, "select", *args, "--stream-above", "0"], directory)
+        if one.returncode != 0:
+            failures.append(f"{label}: one process exit {one.returncode}: {one.stderr[-500:]}")
+            continue
+        for ranks in (2, 3):
+            many = run([mpiexec, "-np", str(ranks), sidc, "select", *args, "--stream-above", "0"], directory)
+            tag = f"{label} (-np {ranks})"
+            if many.returncode != 0 or f"processes: {ranks} MPI ranks" not in many.stdout:
+                failures.append(f"{tag}: exit {many.returncode}, stdout {many.stdout[:300]!r}, stderr {many.stderr[-500:]!r}")
+            elif normalised(one.stdout) != normalised(many.stdout):
+                diff = [f"  {x!r}\n  {y!r}" for x, y in zip(normalised(one.stdout).splitlines(), normalised(many.stdout).splitlines()) if x != y]
+                failures.append(f"{tag}: reports differ:\n" + "\n".join(diff[:5]))
         print(f"checked: {label}", flush=True)
 
     # Faults. Rank 1 runs in a copy of the example whose record has a broken cell in y on line 41.

@@ -12,6 +12,7 @@
 #include <span>
 #include <thread>
 
+#include "runtime/select/select.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/row_share.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
@@ -25,11 +26,11 @@ namespace {
 // The parts' meeting room: each part leaves its state, all wait, each merges all states in part
 // order (so every part computes the same bits), all wait again before the room is reused.
 struct ThreadRoom {
-  explicit ThreadRoom(int n) : parts(n), barrier(n), states(static_cast<std::size_t>(n)), counts(static_cast<std::size_t>(n)),
-                               values(static_cast<std::size_t>(n)), problems(static_cast<std::size_t>(n)) {}
+  explicit ThreadRoom(int n) : parts(n), barrier(n), states(static_cast<std::size_t>(n)), values(static_cast<std::size_t>(n)),
+                               problems(static_cast<std::size_t>(n)) {}
   int parts;
   std::barrier<> barrier;
-  std::vector<std::vector<double>> states, counts, values;
+  std::vector<std::vector<double>> states, values;
   std::vector<char> problems;
   int problem_rounds = 0;  // combines that found a problem in some part's rows (counted by part 0)
   int sums = 0;            // sum() calls (counted by part 0)
@@ -40,10 +41,10 @@ class ThreadShare final : public RowShare {
   ThreadShare(ThreadRoom& room, int part) : room_(room), part_(part) {}
   int part() const override { return part_; }
   int parts() const override { return room_.parts; }
-  Combined combine(TriangularAccumulator& accumulator, std::vector<double>& counts, bool has_problem) override {
+  // Merged left to right in part order (MPI's share merges by a tree: the same to rounding).
+  Combined merge(std::vector<double>& state, const Merge& merge_two, bool has_problem) override {
     const auto me = static_cast<std::size_t>(part_);
-    room_.states[me] = accumulator.to_doubles();
-    room_.counts[me] = counts;
+    room_.states[me] = state;
     room_.problems[me] = has_problem ? 1 : 0;
     room_.barrier.arrive_and_wait();
     Combined result;
@@ -51,16 +52,9 @@ class ThreadShare final : public RowShare {
       result.outcome = Outcome::problem;
       if (part_ == 0) ++room_.problem_rounds;
     } else {
-      TriangularAccumulator merged(accumulator.columns()), other(accumulator.columns());
-      EXPECT_TRUE(merged.from_doubles(room_.states[0]));
-      std::vector<double> sums = room_.counts[0];
-      for (std::size_t k = 1; k < room_.states.size(); ++k) {
-        EXPECT_TRUE(other.from_doubles(room_.states[k]));
-        merged.merge(other);
-        for (std::size_t j = 0; j < sums.size(); ++j) sums[j] += room_.counts[k][j];
-      }
-      accumulator = merged;
-      counts = sums;
+      std::vector<double> merged = room_.states[0];
+      for (std::size_t k = 1; k < room_.states.size(); ++k) merge_two(merged, room_.states[k]);
+      state = merged;
     }
     room_.barrier.arrive_and_wait();
     return result;
@@ -258,6 +252,53 @@ TEST(RowShare, WeakFormRowsAreOneProcessesBitForBit) {
       EXPECT_EQ(part.groups[0].summary.parameters[k].value, one.groups[0].summary.parameters[k].value);
   }
   EXPECT_GE(sums, 4) << "the weak rows were to be shared: one sum per operation";
+}
+
+// sidc select's streamed rows: each part folds its share of the window into the time blocks'
+// triangles and line sums, merged in part order; every part selects what one process selects.
+TEST(RowShare, SelectionAsOneProcessSelects) {
+  const ir::Model m = testing::compiled_text("q.sid", testing::read_text(SIDC_SOURCE_DIR "/examples/thesis-4-1/select_sixth.sid"));
+  const std::vector<SampledRecord> records{testing::appendix_a(m), testing::appendix_a(m, 2)};
+  SelectOptions o;
+  o.method = SelectionMethod::stlsq;  // the rows are what is shared; the search is any (exact: seconds)
+  o.fit.stream_above_entries = 0;
+  o.fit.stream_block_rows = 5;
+  o.fit.stream_threads = 1;
+  o.fit.stream_stretch_rows = 16;
+  auto single = select_operations(m, records, o);
+  ASSERT_TRUE(std::holds_alternative<SelectSummary>(single)) << render(std::get<Diagnostic>(single));
+  const SelectSummary& one = std::get<SelectSummary>(single);
+  ASSERT_TRUE(one.ok()) << one.message;
+  const int parts = 3;
+  ThreadRoom room(parts);
+  std::vector<ThreadShare> shares;
+  for (int k = 0; k < parts; ++k) shares.emplace_back(room, k);
+  std::vector<std::variant<SelectSummary, Diagnostic>> results(parts);
+  std::vector<std::thread> threads;
+  for (int k = 0; k < parts; ++k)
+    threads.emplace_back([&, k] {
+      SelectOptions mine = o;
+      mine.fit.share = &shares[static_cast<std::size_t>(k)];
+      results[static_cast<std::size_t>(k)] = select_operations(m, records, mine);
+    });
+  for (auto& t : threads) t.join();
+  for (const auto& result : results) {
+    ASSERT_TRUE(std::holds_alternative<SelectSummary>(result)) << render(std::get<Diagnostic>(result));
+    const SelectSummary& part = std::get<SelectSummary>(result);
+    ASSERT_EQ(part.groups.size(), one.groups.size());
+    for (std::size_t g = 0; g < one.groups.size(); ++g) {
+      EXPECT_EQ(part.groups[g].n, one.groups[g].n);
+      EXPECT_EQ(part.groups[g].chosen, one.groups[g].chosen);
+      ASSERT_EQ(part.groups[g].rows.size(), one.groups[g].rows.size());
+      for (std::size_t k = 0; k < one.groups[g].rows.size(); ++k) {
+        EXPECT_EQ(part.groups[g].rows[k].parameters, one.groups[g].rows[k].parameters);
+        EXPECT_NEAR(part.groups[g].rows[k].G, one.groups[g].rows[k].G, 1e-8 * one.groups[g].rows[k].G);
+      }
+      ASSERT_EQ(part.groups[g].drift.size(), one.groups[g].drift.size());
+      for (std::size_t k = 0; k < one.groups[g].drift.size(); ++k)
+        EXPECT_NEAR(part.groups[g].drift[k].share, one.groups[g].drift[k].share, 1e-10);
+    }
+  }
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ RowShare::Combined RowShare::combine(TriangularAccumulator& accumulator, std::ve
   const std::vector<double> factor = accumulator.to_doubles();
   state.insert(state.end(), factor.begin(), factor.end());
   const int p = accumulator.columns();
-  const auto unpack = [p](const std::vector<double>& s, std::vector<double>& sums, TriangularAccumulator& into) {
+  const auto unpack = [](const std::vector<double>& s, std::vector<double>& sums, TriangularAccumulator& into) {
     const auto k = static_cast<std::ptrdiff_t>(s.at(0));
     sums.assign(s.begin() + 1, s.begin() + 1 + k);
     into.from_doubles(std::vector<double>(s.begin() + 1 + k, s.end()));

@@ -202,6 +202,27 @@ void stream_rows(const StreamPlan& plan, const WholeWindowValues& whole, StreamW
   }
 }
 
+// A process's rows of a shared group, counted record by record (each record's window times the
+// group's equations). With at least as many records as processes, whole records: each boundary of
+// the even split moved to the nearest record start, so that the records go whole to the processes,
+// in order and balanced by rows (no process carries an integral from the start of a record it
+// shares with another); with fewer, the even split in whole blocks (RowShare::share_of).
+std::pair<std::size_t, std::size_t> rows_of_part(const std::vector<FitWindow>& windows, std::size_t equations, std::size_t block_rows,
+                                                 const RowShare& share) {
+  std::vector<std::size_t> starts{0};  // each record's first row, and the end
+  for (const auto& w : windows) starts.push_back(starts.back() + w.size() * equations);
+  const std::size_t total = starts.back();
+  const auto even = [&](int k) { return RowShare::share_of(total, block_rows, k, share.parts()).first; };
+  if (windows.size() < static_cast<std::size_t>(share.parts())) return {even(share.part()), even(share.part() + 1)};
+  const auto nearest_start = [&](int k) {
+    const std::size_t at = even(k);  // even(parts) is the total, itself a start
+    const auto after = std::lower_bound(starts.begin(), starts.end(), at);
+    if (after == starts.begin()) return *after;
+    return at - *(after - 1) <= *after - at ? *(after - 1) : *after;
+  };
+  return {nearest_start(share.part()), nearest_start(share.part() + 1)};
+}
+
 // The streamed path for one group (FitOptions::stream_above_entries).
 std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector<SampledRecord>& records,
                                        const std::vector<FitWindow>& windows, const FitOptions& options,
@@ -269,8 +290,8 @@ std::optional<Diagnostic> stream_group(const ir::Model& model, const std::vector
   std::size_t folded = 0, to_fold = 0;
   for (const auto& w : windows) to_fold += w.size() * g.equations.size();
   RowShare* share = options.share && options.share->parts() > 1 && plan.guard_sums.size() <= kMostSharedGuards ? options.share : nullptr;
-  const auto [share_first, share_last] =
-      share ? RowShare::share_of(to_fold, block_rows, share->part(), share->parts()) : std::pair<std::size_t, std::size_t>{0, to_fold};
+  const auto [share_first, share_last] = share ? rows_of_part(windows, g.equations.size(), block_rows, *share)
+                                               : std::pair<std::size_t, std::size_t>{0, to_fold};
   bool has_problem = false;  // shared: a problem met, to be named by every process alike (below)
   std::size_t offset = 0;    // rows of the records and equations before this one
   for (std::size_t r = 0; r < records.size() && !has_problem; ++r) {

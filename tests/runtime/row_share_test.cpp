@@ -203,6 +203,32 @@ TEST(RowShare, IntegratedFormOverTwoRecordsAsOneProcessFitsIt) {
   expect_parts_agree(m, {testing::appendix_a(m), testing::appendix_a(m, 2)}, streamed_in_blocks(4));
 }
 
+// With as many records as parts, each part folds whole records (no integral carried from the start of
+// a record another part folds too): the thesis record (its rows to t = 0.82) and its every-other-
+// sample copy, about 80 and 40 rows, go one to each part. The progress hook tells each part's rows.
+TEST(RowShare, RecordsGoWholeToThePartsWhenThereAreEnough) {
+  const ir::Model m = testing::compiled_text("q.sid", testing::read_text(SIDC_SOURCE_DIR "/examples/thesis-4-1/quasi_linear.sid"));
+  const std::vector<SampledRecord> records{testing::appendix_a(m), testing::appendix_a(m, 2)};
+  auto single = fit(m, records, streamed_in_blocks(4));
+  ASSERT_TRUE(std::holds_alternative<FitSummary>(single));
+  const auto& rows = std::get<FitSummary>(single).groups[0].records;
+  ASSERT_EQ(rows.size(), 2u);
+  ThreadRoom room(2);
+  std::vector<ThreadShare> shares{{room, 0}, {room, 1}};
+  std::vector<std::size_t> totals(2, 0);
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 2; ++k)
+    threads.emplace_back([&, k] {
+      FitOptions o = streamed_in_blocks(4);
+      o.share = &shares[static_cast<std::size_t>(k)];
+      o.progress = [&totals, k](std::size_t, std::size_t total) { totals[static_cast<std::size_t>(k)] = total; };
+      EXPECT_TRUE(std::holds_alternative<FitSummary>(fit(m, records, o)));
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(totals[0], rows[0].rows);
+  EXPECT_EQ(totals[1], rows[1].rows);
+}
+
 // A value that cannot be evaluated in the last part's rows only: every part names the problem one
 // process names (the same text), none a problem of its own share.
 TEST(RowShare, AProblemInOnePartIsNamedAsOneProcessNamesIt) {

@@ -22,22 +22,16 @@ import shutil
 import statistics
 import subprocess
 import sys
-import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "streaming"))
-from run import FORMS, MODEL  # noqa: E402  (bench/streaming/run.py: the same models)
+from run import FORMS, MODEL, run_once as timed_run  # noqa: E402  (bench/streaming/run.py: the same models and timer)
 
 
 def run_once(command, cwd):
-    with open(os.path.join(cwd, "last.out"), "wb") as out, open(os.path.join(cwd, "last.err"), "wb") as err:
-        start = time.monotonic()
-        child = subprocess.Popen(command, cwd=cwd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
-        _, status, usage = os.wait4(child.pid, 0)
-        wall = time.monotonic() - start
-    code = os.waitstatus_to_exitcode(status)
+    """streaming/run.py's timed run (wall, peak MiB, exit code), and the report it printed."""
+    wall, peak, code = timed_run(command, cwd)
     with open(os.path.join(cwd, "last.out"), errors="replace") as f:
-        report = f.read()
-    return wall, usage.ru_maxrss / 1024.0, code, report
+        return wall, peak, code, f.read()
 
 
 PARAMETER = re.compile(r"^  (\S+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+\[")

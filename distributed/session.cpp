@@ -31,7 +31,6 @@ bool launched_as_rank() {
   return false;
 }
 
-
 }  // namespace
 
 #ifdef SIDC_HAVE_MPI

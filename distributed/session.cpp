@@ -24,12 +24,14 @@ std::unique_ptr<Session>& instance() {
   return session;
 }
 
+#ifdef SIDC_HAVE_MPI
 // True when a launcher (mpirun, srun) started this process as one rank of a job.
 bool launched_as_rank() {
   for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
     if (std::getenv(name)) return true;
   return false;
 }
+#endif
 
 }  // namespace
 

@@ -86,5 +86,13 @@ int main(int argc, char** argv) {
   // Under mpirun, every rank; one process otherwise (distributed/session.hpp). Every return below
   // goes through finish(), the ranks' last exchange.
   auto& session = sidc::distributed::Session::start(argc, argv);
+  if (!session.launch_problem().empty()) {
+    if (session.is_writer())
+      std::cerr << sidc::render(sidc::diag::error("no-mpi", {}, session.launch_problem(),
+                                                  "rebuild with Open MPI (bash scripts/setup.sh installs libopenmpi-dev and openmpi-bin), "
+                                                  "or run sidc without mpirun"))
+                << "\n";
+    return sidc::exit_code::usage_error;
+  }
   return session.finish(run_command(argc, argv, session));
 }

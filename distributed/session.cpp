@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <thread>
@@ -178,9 +179,25 @@ bool Session::agree(int my_code) {
 #else
 struct Session::Share {};
 
+namespace {
+// A launcher's size and rank, read from the environment it sets (Open MPI, PMIx, PMI).
+int launched_number(std::initializer_list<const char*> names, int otherwise) {
+  for (const char* name : names)
+    if (const char* value = std::getenv(name)) return std::atoi(value);
+  return otherwise;
+}
+}  // namespace
+
 Session& Session::start(int&, char**&) {
   instance().reset(new Session());
-  return *instance();
+  Session& session = *instance();
+  const int size = launched_number({"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE"}, 1);
+  if (size > 1) {
+    session.rank_ = launched_number({"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"}, 0);
+    session.launch_problem_ = fmt::format(
+        "this sidc was built without MPI, and a launcher started {} copies of it: each would fit alone and write the same files", size);
+  }
+  return session;
 }
 std::vector<int> Session::exchange(Status) { return {}; }
 Session::~Session() = default;

@@ -37,6 +37,9 @@ class Session {
   bool is_writer() const { return rank_ == 0; }  // prints and writes files
   // Threads each rank uses for its share: the cores of its node divided among the ranks on it.
   int threads_per_rank() const { return threads_per_rank_; }
+  // Non-empty when a launcher started several copies of a sidc built without MPI: each would fit
+  // alone and write the same files, so the command line refuses to start (rank 0 says why).
+  const std::string& launch_problem() const { return launch_problem_; }
   // The report's line naming the processes; empty for one process.
   std::string processes_line() const;
   // The rows' share among the ranks; null for one process.
@@ -66,6 +69,7 @@ class Session {
   bool someone_left_ = false;  // another rank has made its last exchange
   bool left_ = false;          // this rank has made its last exchange
   std::vector<int> last_statuses_;
+  std::string launch_problem_;
   int held_stderr_ = -1, real_stderr_ = -1;  // ranks above 0: the file their stderr goes to, and the terminal's
   struct Share;
   Share* share_ = nullptr;

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """`mpirun -np N sidc fit` against `sidc fit` (issue 17, docs/distributed.md).
 
-For every case (bundled examples, the NIST sets, a fit of two records; and three selections) and
-N = 2 and 3 ranks
-(oversubscribed on a smaller machine), with every group streamed (`--stream-above 0`) so that the
-ranks really share the rows:
+For every case (bundled examples, local fits, refinement with instrumental variables, the NIST
+sets, a fit of two records; and three selections) and N = 2 and 3 ranks
+(oversubscribed on a smaller machine), with every group streamed (`--stream-above 0`, unless the
+case keeps the design in memory, as instrumental variables need) so that the ranks share the rows:
 - the same exit code, and the same report on stdout apart from the line naming the processes and
   the streamed group's "solved:" line (threads and ranks);
 - fit.json's estimates and standard errors equal to the single process's to 1e-12 relative (of the
@@ -85,6 +85,9 @@ cases = [
     (os.path.join(examples, "pendulum-length"), ["pendulum.sid"]),       # a nonlinear parameter: many fits, each collective
     (os.path.join(examples, "time-varying"),                             # two records
      ["drift.sid", "--form", "integrated", "--data", "drift.csv", "--data", "jump.csv"]),
+    (os.path.join(examples, "time-varying"), ["drift.sid", "--local", "20"]),  # local fits after the global one
+    # Refinement and instrumental variables after a fit in memory (IV needs the design whole).
+    (os.path.join(examples, "thesis-4-1"), ["quasi_linear.sid", "--refine", "--estimator", "iv", "--stream-above", "8000000"]),
 ] + [(nist, [name]) for name in sorted(os.listdir(nist)) if name.endswith(".sid")]
 
 work = tempfile.mkdtemp(prefix="sidc-mpi-")
@@ -92,7 +95,9 @@ try:
     for case, (directory, args) in enumerate(cases):
         label = " ".join(args)
         one_dir = os.path.join(work, f"{case}-1")
-        one = run([sidc, "fit", *args, "--stream-above", "0", "--out", one_dir], directory)
+        # Every design streamed, so that the ranks share the rows, unless the case says otherwise.
+        streamed = [] if "--stream-above" in args else ["--stream-above", "0"]
+        one = run([sidc, "fit", *args, *streamed, "--out", one_dir], directory)
         if one.returncode != 0:
             failures.append(f"{label}: one process exit {one.returncode}: {one.stderr[-500:]}")
             continue
@@ -100,7 +105,7 @@ try:
             failures.append(f"{label}: one process names processes")
         for ranks in (2, 3):
             many_dir = os.path.join(work, f"{case}-{ranks}")
-            many = run([mpiexec, "-np", str(ranks), sidc, "fit", *args, "--stream-above", "0", "--out", many_dir], directory)
+            many = run([mpiexec, "-np", str(ranks), sidc, "fit", *args, *streamed, "--out", many_dir], directory)
             tag = f"{label} (-np {ranks})"
             if many.returncode != 0:
                 failures.append(f"{tag}: exit {many.returncode}: {many.stderr[-800:]}")

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <initializer_list>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <unistd.h>
@@ -46,11 +47,17 @@ struct Session::Share final : RowShare {
   int part() const override { return session.rank_; }
   int parts() const override { return session.size_; }
 
+  // Every collective's first step: the status exchange. Its outcome when the collective is not to
+  // go on (a rank has left, or met a problem in its rows), nothing when it is.
+  std::optional<Combined> statuses_say_stop(bool has_problem) {
+    const std::vector<int> statuses = session.exchange(has_problem ? working_with_problem : working);
+    if (session.someone_left_) return Combined{Outcome::stopped, session.who_left()};
+    if (std::any_of(statuses.begin(), statuses.end(), [](int s) { return s == working_with_problem; })) return Combined{Outcome::problem, {}};
+    return std::nullopt;
+  }
+
   Combined merge(std::vector<double>& state, const Merge& merge_two, bool has_problem) override {
-    session.exchange(has_problem ? working_with_problem : working);
-    if (session.someone_left_) return {Outcome::stopped, session.who_left()};
-    if (std::any_of(session.last_statuses_.begin(), session.last_statuses_.end(), [](int s) { return s == working_with_problem; }))
-      return {Outcome::problem, {}};
+    if (auto stop = statuses_say_stop(has_problem)) return *stop;
     const int rank = session.rank_, size = session.size_;
     for (int step = 1; step < size; step *= 2) {
       if (rank % (2 * step) != 0) {  // hand this subtree's state up and leave the tree
@@ -74,10 +81,7 @@ struct Session::Share final : RowShare {
   }
 
   Combined sum(std::span<double> values, bool has_problem) override {
-    session.exchange(has_problem ? working_with_problem : working);
-    if (session.someone_left_) return {Outcome::stopped, session.who_left()};
-    if (std::any_of(session.last_statuses_.begin(), session.last_statuses_.end(), [](int s) { return s == working_with_problem; }))
-      return {Outcome::problem, {}};
+    if (auto stop = statuses_say_stop(has_problem)) return *stop;
     MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
     return {Outcome::combined, {}};
   }

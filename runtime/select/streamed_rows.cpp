@@ -222,18 +222,21 @@ std::variant<StreamedRows, Diagnostic> stream_record_rows(const ir::Model& model
     }
   }
   if (failed && !share) return StreamedRows::use_whole_rows;
-  // This record's time-block triangles, apart from `blocks` (which may hold earlier records' rows).
-  std::vector<TriangularAccumulator> mine(F, TriangularAccumulator(static_cast<int>(p)));
-  for (const auto& w : workers)
-    for (std::size_t b = 0; b < F; ++b) mine[b].merge(w.blocks[b]);
-  if (share) {
-    // Every process's triangles merged and line pieces joined in process order (each piece's rows
-    // come right after the last one's); a problem anywhere sends every process to the whole rows.
+  if (!share) {
+    for (const auto& w : workers)
+      for (std::size_t b = 0; b < F; ++b) blocks[b].merge(w.blocks[b]);
+  } else {
+    // This record's triangles apart from `blocks` (which may hold earlier records' rows): every
+    // process's merged and line pieces joined in process order (each piece's rows come right after
+    // the last one's); a problem anywhere sends every process to the whole rows.
+    std::vector<TriangularAccumulator> mine(F, TriangularAccumulator(static_cast<int>(p)));
+    for (const auto& w : workers)
+      for (std::size_t b = 0; b < F; ++b) mine[b].merge(w.blocks[b]);
     auto merged = merge_record_pieces(*share, mine, lines, static_cast<int>(p), failed);
     if (auto* d = std::get_if<Diagnostic>(&merged)) return *d;
     if (!std::get<bool>(merged)) return StreamedRows::use_whole_rows;
+    for (std::size_t b = 0; b < F; ++b) blocks[b].merge(mine[b]);
   }
-  for (std::size_t b = 0; b < F; ++b) blocks[b].merge(mine[b]);
   shares.clear();
   for (const auto& l : lines) shares.push_back(l.shares());
   return StreamedRows::folded;

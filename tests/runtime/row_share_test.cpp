@@ -11,6 +11,7 @@
 #include <random>
 #include <span>
 #include <thread>
+#include <utility>
 
 #include "runtime/select/select.hpp"
 #include "runtime/solve/fit.hpp"
@@ -85,24 +86,30 @@ class ThreadShare final : public RowShare {
   int part_;
 };
 
-std::variant<FitSummary, Diagnostic> fit_in_parts_part(const ir::Model& m, const std::vector<SampledRecord>& records, FitOptions o,
-                                                       ThreadShare& share) {
-  o.share = &share;
-  return fit(m, records, o);
+// run(share, k) for every part k of the room, the parts side by side as threads; their results.
+template <class Run>
+auto in_parts(ThreadRoom& room, Run run) {
+  using Result = decltype(run(std::declval<RowShare&>(), 0));
+  std::vector<ThreadShare> shares;
+  for (int k = 0; k < room.parts; ++k) shares.emplace_back(room, k);
+  std::vector<Result> results(static_cast<std::size_t>(room.parts));
+  std::vector<std::thread> threads;
+  for (int k = 0; k < room.parts; ++k)
+    threads.emplace_back([&, k] { results[static_cast<std::size_t>(k)] = run(shares[static_cast<std::size_t>(k)], k); });
+  for (auto& t : threads) t.join();
+  return results;
 }
 
-// Every part's result, the parts running side by side as threads.
+// Every part's fit.
 std::vector<std::variant<FitSummary, Diagnostic>> fit_in_parts(const ir::Model& m, const std::vector<SampledRecord>& records,
                                                                const FitOptions& o, int parts, int* problem_rounds = nullptr,
                                                                int* sums = nullptr) {
   ThreadRoom room(parts);
-  std::vector<ThreadShare> shares;
-  for (int k = 0; k < parts; ++k) shares.emplace_back(room, k);
-  std::vector<std::variant<FitSummary, Diagnostic>> results(static_cast<std::size_t>(parts));
-  std::vector<std::thread> threads;
-  for (int k = 0; k < parts; ++k)
-    threads.emplace_back([&, k] { results[static_cast<std::size_t>(k)] = fit_in_parts_part(m, records, o, shares[static_cast<std::size_t>(k)]); });
-  for (auto& t : threads) t.join();
+  auto results = in_parts(room, [&](RowShare& share, int) {
+    FitOptions mine = o;
+    mine.share = &share;
+    return fit(m, records, mine);
+  });
   if (problem_rounds) *problem_rounds = room.problem_rounds;
   if (sums) *sums = room.sums;
   return results;
@@ -214,17 +221,14 @@ TEST(RowShare, RecordsGoWholeToThePartsWhenThereAreEnough) {
   const auto& rows = std::get<FitSummary>(single).groups[0].records;
   ASSERT_EQ(rows.size(), 2u);
   ThreadRoom room(2);
-  std::vector<ThreadShare> shares{{room, 0}, {room, 1}};
   std::vector<std::size_t> totals(2, 0);
-  std::vector<std::thread> threads;
-  for (int k = 0; k < 2; ++k)
-    threads.emplace_back([&, k] {
-      FitOptions o = streamed_in_blocks(4);
-      o.share = &shares[static_cast<std::size_t>(k)];
-      o.progress = [&totals, k](std::size_t, std::size_t total) { totals[static_cast<std::size_t>(k)] = total; };
-      EXPECT_TRUE(std::holds_alternative<FitSummary>(fit(m, records, o)));
-    });
-  for (auto& t : threads) t.join();
+  const auto results = in_parts(room, [&](RowShare& share, int k) {
+    FitOptions o = streamed_in_blocks(4);
+    o.share = &share;
+    o.progress = [&totals, k](std::size_t, std::size_t total) { totals[static_cast<std::size_t>(k)] = total; };
+    return fit(m, records, o);
+  });
+  for (const auto& r : results) EXPECT_TRUE(std::holds_alternative<FitSummary>(r));
   EXPECT_EQ(totals[0], rows[0].rows);
   EXPECT_EQ(totals[1], rows[1].rows);
 }
@@ -295,19 +299,12 @@ TEST(RowShare, SelectionAsOneProcessSelects) {
   ASSERT_TRUE(std::holds_alternative<SelectSummary>(single)) << render(std::get<Diagnostic>(single));
   const SelectSummary& one = std::get<SelectSummary>(single);
   ASSERT_TRUE(one.ok()) << one.message;
-  const int parts = 3;
-  ThreadRoom room(parts);
-  std::vector<ThreadShare> shares;
-  for (int k = 0; k < parts; ++k) shares.emplace_back(room, k);
-  std::vector<std::variant<SelectSummary, Diagnostic>> results(parts);
-  std::vector<std::thread> threads;
-  for (int k = 0; k < parts; ++k)
-    threads.emplace_back([&, k] {
-      SelectOptions mine = o;
-      mine.fit.share = &shares[static_cast<std::size_t>(k)];
-      results[static_cast<std::size_t>(k)] = select_operations(m, records, mine);
-    });
-  for (auto& t : threads) t.join();
+  ThreadRoom room(3);
+  const auto results = in_parts(room, [&](RowShare& share, int) {
+    SelectOptions mine = o;
+    mine.fit.share = &share;
+    return select_operations(m, records, mine);
+  });
   for (const auto& result : results) {
     ASSERT_TRUE(std::holds_alternative<SelectSummary>(result)) << render(std::get<Diagnostic>(result));
     const SelectSummary& part = std::get<SelectSummary>(result);

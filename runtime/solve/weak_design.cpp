@@ -129,8 +129,7 @@ std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::stri
   // in, and g is evaluated on the block and the 2m samples after it. A value that is not finite is
   // looked for on the block's own samples, and the first by term, then sample, is the one
   // Evaluator::evaluate_in_window names.
-  constexpr std::size_t kBlock = kWeakBlock;
-  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  const std::size_t blocks = (n + kWeakBlock - 1) / kWeakBlock;
   first_block = std::min(first_block, blocks);
   last_block = std::clamp(last_block, first_block, blocks);
   std::mutex found;
@@ -138,13 +137,13 @@ std::optional<Diagnostic> WeakValues::add_rows(const ir::Sum& g, const std::stri
   std::optional<Diagnostic> structural;  // a problem that is not a value (the same on every block)
   // Each row is its own dot product: the blocks split over the cores (at 10^7 samples, 8
   // subdomains cover each sample: about 8 * 10^7 products per column, the weak fit's largest cost).
-  for_parallel_ranges(last_block - first_block, std::min(n, (last_block - first_block) * kBlock) * w.size(), [&](std::size_t b0, std::size_t b1) {
+  for_parallel_ranges(last_block - first_block, std::min(n, (last_block - first_block) * kWeakBlock) * w.size(), [&](std::size_t b0, std::size_t b1) {
     b0 += first_block;
     b1 += first_block;
     BlockEvaluator evaluator(record, evaluator_.options(), window, whole);
     std::vector<double> values;
     for (std::size_t b = b0; b < b1; ++b) {
-      const std::size_t start = b * kBlock, end = std::min(n, start + kBlock), last = std::min(n, end + 2 * m);
+      const std::size_t start = b * kWeakBlock, end = std::min(n, start + kWeakBlock), last = std::min(n, end + 2 * m);
       values.assign(last - start, 0.0);
       evaluator.start_block(window.first + start, window.first + last);
       std::optional<NonFiniteValue> bad;

@@ -91,6 +91,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   // Under mpirun: the rows shared among the ranks, rank 0 alone printing and writing (session.hpp).
   distributed::Session& session = distributed::Session::current();
   settings.share = session.row_share();
+  settings.records.share = settings.share;  // each record read by byte ranges
   settings.threads = session.threads_per_rank();
   settings.processes = session.processes_line();
   ProgressLine progress;  // on stderr, only when it is a terminal

@@ -93,6 +93,7 @@ int run_select(const SelectArguments& a) {
   // Under mpirun: the streamed rows shared among the ranks, rank 0 alone printing and writing.
   distributed::Session& session = distributed::Session::current();
   s.share = session.row_share();
+  s.records.share = s.share;  // each record read by byte ranges
   s.threads = session.threads_per_rank();
   s.stream_above = a.stream_above;
   s.processes = session.processes_line();

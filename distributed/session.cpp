@@ -80,6 +80,19 @@ struct Session::Share final : RowShare {
     return {Outcome::combined, {}};
   }
 
+  // Part k's values broadcast from rank k, in pieces of at most 2^30 values (MPI counts are ints).
+  void concatenate(std::span<const double> mine, std::span<double> all, std::span<const std::size_t> lengths) override {
+    constexpr std::size_t kPiece = std::size_t{1} << 30;
+    std::size_t offset = 0;
+    for (int k = 0; k < session.size_; ++k) {
+      const std::size_t length = lengths[static_cast<std::size_t>(k)];
+      if (k == session.rank_) std::copy(mine.begin(), mine.end(), all.begin() + static_cast<std::ptrdiff_t>(offset));
+      for (std::size_t done = 0; done < length; done += kPiece)
+        MPI_Bcast(all.data() + offset + done, static_cast<int>(std::min(kPiece, length - done)), MPI_DOUBLE, k, MPI_COMM_WORLD);
+      offset += length;
+    }
+  }
+
   Combined sum(std::span<double> values, bool has_problem) override {
     if (auto stop = statuses_say_stop(has_problem)) return *stop;
     MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
@@ -238,8 +251,8 @@ std::string Session::who_left() const {
 
 std::string Session::processes_line() const {
   if (size_ <= 1) return {};
-  return fmt::format("processes: {} MPI ranks of {} thread{} each; they share the rows of every streamed design and the weak "
-                     "form's integrals, and each evaluates smaller designs whole (docs/distributed.md)",
+  return fmt::format("processes: {} MPI ranks of {} thread{} each; each parses its byte range of every record, they share the rows "
+                     "of every streamed design and the weak form's integrals, and each evaluates smaller designs whole (docs/distributed.md)",
                      size_, threads_per_rank_, threads_per_rank_ == 1 ? "" : "s");
 }
 

@@ -70,8 +70,9 @@ ir::DataSource source_of(const ir::Model& model, const RecordInput& input) {
 using Progress = std::function<void(const std::string& phase, std::size_t done, std::size_t total)>;
 
 std::variant<SampledRecord, Diagnostic> read_and_bind(RecordInput input, const ir::DataSource& source, const ir::Model& model, const BindOptions& bind,
-                                                      const Progress& progress = nullptr) {
+                                                      const Progress& progress = nullptr, PartShare* share = nullptr) {
   CsvOptions csv;
+  csv.share = share;
   if (progress && std::holds_alternative<std::string>(input))
     csv.progress = [&progress, phase = "reading " + std::get<std::string>(input) + " (bytes)"](std::size_t done, std::size_t total) {
       progress(phase, done, total);
@@ -103,7 +104,7 @@ std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compil
   out.bind = bind_options(std::get<EvaluationSettings>(settings));
   out.bind.resample = a.resample;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
-    auto bound = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress);
+    auto bound = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress, a.share);
     if (auto* d = std::get_if<Diagnostic>(&bound)) return *d;
     out.records.push_back(std::get<SampledRecord>(std::move(bound)));
   }

@@ -31,6 +31,9 @@ struct RecordSettings {
   std::optional<double> from, to, step, resample;
   std::optional<int> every;
   std::string derivative, second_derivative, edges, integration, precision, weights;
+  // The processes that read each record together, each its own byte range (CsvOptions::share; the
+  // command line under mpirun; not owned). Null: every record read whole here.
+  PartShare* share = nullptr;
 };
 
 // The model's settings overridden; a moving arc that cannot be read is the error.

@@ -2,8 +2,9 @@
 // file, a larger one in pieces that end at line ends (read_csv_in_pieces: the text is never held
 // whole), never mapped (a file truncated while mapped ends the process with SIGBUS;
 // diagnostics/regular_file.hpp); then one pass over the bytes of each, on two threads for large
-// ones (the second half from a line start near the middle; see parse_rows_on_two_threads). The
-// fast path per cell
+// ones (the second half from a line start near the middle; see parse_rows_on_two_threads). Under
+// mpirun each process reads one byte range of the file and the parts are put together
+// (read_csv_by_parts). The fast path per cell
 // reads the number straight off the buffer (read_simple_number, else std::from_chars; both stop
 // at the separator by themselves), so a cell costs one conversion and a comparison; everything
 // unusual (quotes, `+`, `D` exponents, decimal commas, text, NaN) falls to a slow path that
@@ -31,6 +32,7 @@
 #include <unordered_map>
 
 #include "diagnostics/regular_file.hpp"
+#include "runtime/records/part_share.hpp"
 
 namespace sidc {
 namespace {
@@ -174,6 +176,31 @@ struct Field {
   bool quoted = false;
 };
 
+// The bookkeeping of rows parsed apart (a second thread's, another process's) put after the rows
+// before them: `later`'s rows are numbered from 0 and its lines from 1; the `rows` and `lines`
+// before them shift both. Each column keeps its first kFaultsKeptPerColumn faulty cells.
+void append_later_rows(std::vector<std::vector<FaultyCell>>& faults, std::vector<std::pair<std::size_t, int>>& jumps, std::size_t rows,
+                       int lines, std::vector<std::vector<FaultyCell>> later_faults, const std::vector<std::pair<std::size_t, int>>& later_jumps) {
+  for (std::size_t j = 0; j < faults.size() && j < later_faults.size(); ++j) {
+    auto& kept = faults[j];
+    for (auto& fault : later_faults[j]) {
+      if (kept.size() >= kFaultsKeptPerColumn) break;
+      fault.row += rows;
+      kept.push_back(std::move(fault));
+    }
+  }
+  for (const auto& [row, line] : later_jumps) {
+    const std::size_t shifted_row = row + rows;
+    const int shifted_line = line + lines;
+    // The later rows' first row always starts a jump of its own; keep it only when it is one (the
+    // row before it, the last before them, lies on the line before).
+    if (row == 0 && shifted_row > 0 && !jumps.empty() &&
+        jumps.back().second + static_cast<int>(shifted_row - 1 - jumps.back().first) + 1 == shifted_line)
+      continue;
+    jumps.emplace_back(shifted_row, shifted_line);
+  }
+}
+
 class CsvParser {
  public:
   CsvParser(std::string_view text, const std::string& path, const CsvOptions& options)
@@ -190,6 +217,14 @@ class CsvParser {
   // Whether `text` holds the line begin_text looks for first (neither blank nor a comment), whole.
   bool holds_first_line(std::string_view text) const;
   void reserve_rows(const char* p, std::size_t remaining);
+  // For a part of the file read apart (read_csv_by_parts): its lines numbered from `first_line`
+  // (1: numbered within the part, shifted afterwards), and what it has read.
+  void restart_lines(int first_line) {
+    line_ = first_line;
+    expected_line_ = 0;
+  }
+  int lines_read() const { return line_ - 1; }  // lines before the next one, counted from the first
+  Record& record() { return record_; }
 
  private:
   // Line bookkeeping.
@@ -492,26 +527,12 @@ std::optional<Diagnostic> CsvParser::parse_rows_on_two_threads(const char* p, co
   if (head_error) return head_error;
   if (tail_error) return parse_rows(split);  // line_ is where the first part ended: the file's numbering
   const std::size_t head_rows = record_.rows();
-  const int line_offset = line_ - 1;  // tail line 1 is file line line_
   for (std::size_t j = 0; j < record_.columns.size(); ++j) {
     auto& column = record_.columns[j];
     column.insert(column.end(), tail.record_.columns[j].begin(), tail.record_.columns[j].end());
-    auto& kept = record_.first_faults[j];
-    for (auto& fault : tail.record_.first_faults[j]) {
-      if (kept.size() >= kFaultsKeptPerColumn) break;
-      fault.row += head_rows;
-      kept.push_back(std::move(fault));
-    }
   }
-  for (const auto& [row, line] : tail.record_.line_jumps) {
-    const std::size_t shifted_row = row + head_rows;
-    const int shifted_line = line + line_offset;
-    // The tail's first row always starts a jump of its own; keep it only when it is one.
-    if (shifted_row > 0 && record_.line_of_original_row(shifted_row - 1) + 1 == shifted_line &&
-        !record_.line_jumps.empty() && row == 0)
-      continue;
-    record_.line_jumps.emplace_back(shifted_row, shifted_line);
-  }
+  append_later_rows(record_.first_faults, record_.line_jumps, head_rows, line_ - 1, std::move(tail.record_.first_faults),
+                    tail.record_.line_jumps);
   line_ += tail.line_ - 1;
   return std::nullopt;
 }
@@ -688,77 +709,333 @@ Diagnostic refused(const std::string& path, const FileRefusal& refusal) {
   return data_diag::cannot_open(path, refusal.reason == std::strerror(ENOENT) ? "no such file" : refusal.reason);
 }
 
-// A file larger than CsvOptions::chunk_bytes, read and parsed piece by piece: each piece ends at
-// its last line end (a line longer than a piece grows the buffer), so memory is a piece, not the
-// file. Every answer is the whole file's: a file that changed while read is refused first, a NUL
+// Below: a file larger than CsvOptions::chunk_bytes, read and parsed piece by piece (each piece
+// ends at a line end; a longer line grows the buffer), so memory is a piece, not the file; and a
+// file read by cooperating processes, each its own byte range (read_csv_by_parts). Every answer is
+// the whole file's, as parse_csv gives it: a file that changed while read is refused first, a NUL
 // byte anywhere next (the rest is still read for both), then the first parse problem.
-std::variant<Record, Diagnostic> read_csv_in_pieces(const OpenFile& file, const std::string& path, const CsvOptions& options) {
-  if (std::string why; !options.is_valid(&why)) return data_diag::invalid_csv_options(why);
-  std::size_t capacity = 2 * options.chunk_bytes;
+
+// The file's first lines, read from its start in pieces of 64 KiB and more until the first line
+// that is neither blank nor a comment is whole (or the file ends), then given to begin_text.
+struct HeaderRead {
+  std::optional<Diagnostic> failure;  // the file could not be read
+  std::optional<Diagnostic> binary;   // a NUL byte among the bytes read
+  std::optional<Diagnostic> problem;  // begin_text's: an empty file, a bad header line
+  std::size_t read = 0;               // bytes read from the start
+  std::size_t newlines = 0;           // '\n' bytes among them
+  std::size_t rows_begin = 0;         // without a problem: where the rows begin
+  std::size_t newlines_before_rows = 0;
+};
+
+HeaderRead read_header(const OpenFile& file, const std::string& path, CsvParser& parser) {
+  HeaderRead out;
+  std::size_t want = std::min<std::size_t>(file.size(), std::size_t{1} << 16);
+  std::unique_ptr<char[]> text;
+  std::string_view prefix;
+  for (;;) {
+    text.reset(new (std::nothrow) char[std::max<std::size_t>(want, 1)]);
+    if (!text) {
+      out.failure = data_diag::cannot_open(path, fmt::format("not enough memory for a line of over {} bytes", want / 2));
+      return out;
+    }
+    const long long got = want > 0 ? file.read_at(text.get(), 0, want) : 0;
+    if (got < 0) {
+      out.failure = data_diag::cannot_open(path, std::strerror(static_cast<int>(-got)));
+      return out;
+    }
+    prefix = std::string_view(text.get(), static_cast<std::size_t>(got));
+    if (static_cast<std::size_t>(got) < want || want >= file.size() || parser.holds_first_line(prefix)) break;
+    want = std::min(file.size(), 2 * want);
+  }
+  out.read = prefix.size();
+  out.newlines = static_cast<std::size_t>(std::count(prefix.begin(), prefix.end(), '\n'));
+  if (const void* nul = std::memchr(prefix.data(), '\0', prefix.size())) {
+    const char* at = static_cast<const char*>(nul);
+    const char* line_start = at;
+    while (line_start > prefix.data() && *(line_start - 1) != '\n') --line_start;
+    const auto row = 1 + std::count(prefix.data(), at, '\n');
+    out.binary = data_diag::binary_file(path, static_cast<int>(row), static_cast<int>(at - line_start) + 1);
+    return out;
+  }
+  parser.set_text(prefix);
+  const char* p = nullptr;
+  out.problem = parser.begin_text(p);
+  if (!out.problem) {
+    out.rows_begin = static_cast<std::size_t>(p - prefix.data());
+    out.newlines_before_rows = static_cast<std::size_t>(std::count(prefix.data(), p, '\n'));
+  }
+  parser.set_text({});  // the prefix goes; the names begin_text read are the parser's own
+  return out;
+}
+
+// Bytes [from, to) of `file` (on to the file's end when `to_end`), read in pieces of about
+// CsvOptions::chunk_bytes that end at line ends and, when `parse`, given to parser.rows_of_text
+// until it meets a problem; the bytes after that are still read, for a NUL byte.
+struct RowsRead {
+  std::optional<Diagnostic> failure;  // the file could not be read
+  std::optional<Diagnostic> problem;  // the parser's first
+  std::size_t read = 0;               // bytes read
+  std::size_t newlines = 0;           // '\n' bytes among them, up to the first NUL
+  bool nul = false;                   // a NUL byte among them; the first one's
+  std::size_t nul_newlines = 0;       //   '\n' bytes before it (from `from` on)
+  int nul_column = 0;                 //   and column
+};
+
+RowsRead read_rows(const OpenFile& file, const std::string& path, CsvParser& parser, std::size_t from, std::size_t to, bool to_end,
+                   bool parse, const CsvOptions& options) {
+  RowsRead out;
+  std::size_t capacity = 2 * (options.chunk_bytes > 0 ? options.chunk_bytes : std::size_t{16} << 20);
   std::unique_ptr<char[]> buffer(new (std::nothrow) char[capacity]);
-  if (!buffer) return data_diag::cannot_open(path, fmt::format("not enough memory for a piece of {} bytes", capacity));
-  CsvParser parser(std::string_view(), path, options);
-  std::size_t read = 0, held = 0;   // bytes read from the file; of them, still in the buffer
-  std::size_t newlines_before = 0;  // in the bytes already given up (for a NUL's row)
-  bool started = false, at_end = false;
-  std::optional<Diagnostic> binary, problem;
+  if (!buffer) {
+    out.failure = data_diag::cannot_open(path, fmt::format("not enough memory for a piece of {} bytes", capacity));
+    return out;
+  }
+  const std::size_t last = to_end ? file.size() : to;  // for the progress line and the rows' estimate
+  std::size_t held = 0;  // bytes read and still in the buffer
+  bool at_end = false, reserved = false;
   while (!at_end || held > 0) {
     if (!at_end) {
       if (held == capacity) {  // a line longer than the buffer: double it
         std::unique_ptr<char[]> larger(new (std::nothrow) char[2 * capacity]);
-        if (!larger) return data_diag::cannot_open(path, fmt::format("not enough memory for a line of over {} bytes", capacity));
+        if (!larger) {
+          out.failure = data_diag::cannot_open(path, fmt::format("not enough memory for a line of over {} bytes", capacity));
+          return out;
+        }
         std::memcpy(larger.get(), buffer.get(), held);
         buffer = std::move(larger);
         capacity *= 2;
       }
-      const long long got = file.read_at(buffer.get() + held, read, capacity - held);
-      if (got < 0) return data_diag::cannot_open(path, std::strerror(static_cast<int>(-got)));
-      if (!binary)
+      const std::size_t offset = from + out.read;
+      const std::size_t want = to_end ? capacity - held : std::min(capacity - held, to > offset ? to - offset : 0);
+      const long long got = want > 0 ? file.read_at(buffer.get() + held, offset, want) : 0;
+      if (got < 0) {
+        out.failure = data_diag::cannot_open(path, std::strerror(static_cast<int>(-got)));
+        return out;
+      }
+      if (!out.nul)
         if (const void* nul = std::memchr(buffer.get() + held, '\0', static_cast<std::size_t>(got))) {
           const char* at = static_cast<const char*>(nul);
           const char* line_start = at;
           while (line_start > buffer.get() && *(line_start - 1) != '\n') --line_start;
-          const auto row = 1 + newlines_before + static_cast<std::size_t>(std::count(static_cast<const char*>(buffer.get()), at, '\n'));
-          binary = data_diag::binary_file(path, static_cast<int>(row), static_cast<int>(at - line_start) + 1);
+          out.nul = true;
+          out.nul_newlines = out.newlines + static_cast<std::size_t>(std::count(static_cast<const char*>(buffer.get()), at, '\n'));
+          out.nul_column = static_cast<int>(at - line_start) + 1;
         }
       at_end = got == 0;
-      read += static_cast<std::size_t>(got);
+      out.read += static_cast<std::size_t>(got);
       held += static_cast<std::size_t>(got);
-      if (read > file.size()) break;  // grown: refused below
+      if (to_end && from + out.read > file.size()) break;  // grown: the caller refuses it
     }
-    // The piece: up to the last line end (everything at the end of the file).
+    // The piece: up to the last line end (everything at the end).
     std::size_t cut = held;
     if (!at_end) {
-      const char* last = buffer.get() + held;
-      while (last > buffer.get() && *(last - 1) != '\n') --last;
-      cut = static_cast<std::size_t>(last - buffer.get());
+      const char* end = buffer.get() + held;
+      while (end > buffer.get() && *(end - 1) != '\n') --end;
+      cut = static_cast<std::size_t>(end - buffer.get());
       if (cut == 0) continue;  // no whole line yet
     }
     const std::string_view piece(buffer.get(), cut);
-    if (!binary && !problem) {
+    if (parse && !out.nul && !out.problem) {
       parser.set_text(piece);
-      if (!started) {
-        if (!at_end && !parser.holds_first_line(piece)) continue;  // blank and comment lines only so far: read on
-        const char* p = nullptr;
-        problem = parser.begin_text(p);
-        if (!problem) {
-          parser.reserve_rows(p, file.size() - (read - held) - static_cast<std::size_t>(p - piece.data()));
-          problem = parser.rows_of_text(p);
-        }
-        started = true;
-      } else {
-        problem = parser.rows_of_text(piece.data());
-      }
+      if (!reserved) parser.reserve_rows(piece.data(), last > from ? last - from : 0);
+      reserved = true;
+      out.problem = parser.rows_of_text(piece.data());
     }
-    if (!binary) newlines_before += static_cast<std::size_t>(std::count(piece.begin(), piece.end(), '\n'));
-    if (options.progress) options.progress(std::min(read, file.size()), file.size());
+    if (!out.nul) out.newlines += static_cast<std::size_t>(std::count(piece.begin(), piece.end(), '\n'));
+    if (options.progress) options.progress(std::min(from + out.read, last), last);
     std::memmove(buffer.get(), buffer.get() + cut, held - cut);
     held -= cut;
   }
-  if (read != file.size()) return data_diag::changed_while_read(path, changed_while_read(file.size(), read).reason);
-  if (binary) return *binary;
-  if (problem) return *problem;
-  if (!started) return data_diag::empty_file(path);
+  return out;
+}
+
+std::variant<Record, Diagnostic> read_csv_in_pieces(const OpenFile& file, const std::string& path, const CsvOptions& options) {
+  if (std::string why; !options.is_valid(&why)) return data_diag::invalid_csv_options(why);
+  CsvParser parser(std::string_view(), path, options);
+  const HeaderRead header = read_header(file, path, parser);
+  if (header.failure) return *header.failure;
+  if (header.binary) return *header.binary;
+  // After a problem in the first lines nothing more is parsed, but a NUL byte anywhere comes first.
+  const std::size_t from = header.problem ? header.read : header.rows_begin;
+  const RowsRead rows = read_rows(file, path, parser, from, file.size(), true, !header.problem, options);
+  if (rows.failure) return *rows.failure;
+  if (from + rows.read != file.size()) return data_diag::changed_while_read(path, changed_while_read(file.size(), from + rows.read).reason);
+  const std::size_t newlines_before = header.problem ? header.newlines : header.newlines_before_rows;
+  if (rows.nul) return data_diag::binary_file(path, static_cast<int>(1 + newlines_before + rows.nul_newlines), rows.nul_column);
+  if (header.problem) return *header.problem;
+  if (rows.problem) return *rows.problem;
+  return parser.finish();
+}
+
+// The first line start at or after `offset` (the byte after a '\n'), the file's end when there is
+// none; -errno when the file cannot be read.
+long long line_start_at_or_after(const OpenFile& file, std::size_t offset) {
+  if (offset == 0) return 0;
+  std::vector<char> buffer(std::size_t{1} << 16);
+  for (std::size_t at = offset - 1; at < file.size();) {
+    const long long got = file.read_at(buffer.data(), at, buffer.size());
+    if (got < 0) return got;
+    if (got == 0) break;
+    if (const void* newline = std::memchr(buffer.data(), '\n', static_cast<std::size_t>(got)))
+      return static_cast<long long>(at) + (static_cast<const char*>(newline) - buffer.data()) + 1;
+    at += static_cast<std::size_t>(got);
+  }
+  return static_cast<long long>(file.size());
+}
+
+// What one part has of the record's bookkeeping, as doubles for PartShare::merge: its rows and
+// lines, each column's first faulty cells (row, fault, text), its line jumps.
+std::vector<double> bookkeeping_state(std::size_t rows, int lines, const std::vector<std::vector<FaultyCell>>& faults,
+                                      const std::vector<std::pair<std::size_t, int>>& jumps) {
+  std::vector<double> out{static_cast<double>(rows), static_cast<double>(lines), static_cast<double>(faults.size())};
+  for (const auto& kept : faults) {
+    out.push_back(static_cast<double>(kept.size()));
+    for (const auto& cell : kept) {
+      out.insert(out.end(), {static_cast<double>(cell.row), static_cast<double>(cell.fault), static_cast<double>(cell.text.size())});
+      for (char c : cell.text) out.push_back(static_cast<double>(static_cast<unsigned char>(c)));
+    }
+  }
+  out.push_back(static_cast<double>(jumps.size()));
+  for (const auto& [row, line] : jumps) out.insert(out.end(), {static_cast<double>(row), static_cast<double>(line)});
+  return out;
+}
+
+struct Bookkeeping {
+  std::size_t rows = 0;
+  int lines = 0;
+  std::vector<std::vector<FaultyCell>> faults;
+  std::vector<std::pair<std::size_t, int>> jumps;
+};
+
+Bookkeeping bookkeeping_of(const std::vector<double>& state) {
+  Bookkeeping b;
+  std::size_t i = 0;
+  const auto next = [&] { return state[i++]; };
+  b.rows = static_cast<std::size_t>(next());
+  b.lines = static_cast<int>(next());
+  b.faults.resize(static_cast<std::size_t>(next()));
+  for (auto& kept : b.faults) {
+    kept.resize(static_cast<std::size_t>(next()));
+    for (auto& cell : kept) {
+      cell.row = static_cast<std::size_t>(next());
+      cell.fault = static_cast<CellFault>(static_cast<int>(next()));
+      cell.text.resize(static_cast<std::size_t>(next()));
+      for (char& c : cell.text) c = static_cast<char>(static_cast<unsigned char>(next()));
+    }
+  }
+  b.jumps.resize(static_cast<std::size_t>(next()));
+  for (auto& [row, line] : b.jumps) {
+    row = static_cast<std::size_t>(next());
+    line = static_cast<int>(next());
+  }
+  return b;
+}
+
+// A file read by the parts of options.share (issue 17): each part reads and parses the byte range
+// from the first line start at or after size * k / parts to the next part's start (every part reads
+// the first lines for the header; no range begins before the rows do), its lines and rows numbered
+// within the range; one exchange of every part's counts and outcome, and the answer is settled
+// the same way on every part: a NUL byte (the first part's that has one, its row counted over the
+// parts before), else a parse problem (the first part's, parsed again by every part with the
+// file's line numbers), else every column put together in part order and the faulty cells and line
+// jumps shifted by the rows and lines before them. The record is then parse_csv's, bit for bit.
+std::variant<Record, Diagnostic> read_csv_by_parts(const OpenFile& file, const std::string& path, const CsvOptions& options) {
+  if (std::string why; !options.is_valid(&why)) return data_diag::invalid_csv_options(why);
+  PartShare& share = *options.share;
+  const int part = share.part(), parts = share.parts();
+  CsvParser parser(std::string_view(), path, options);
+  const HeaderRead header = read_header(file, path, parser);
+  if (header.failure) return *header.failure;  // this part leaves; the others learn it in the merge
+  // The first lines are the same bytes for every part: a problem there is every part's, settled
+  // as one process settles it.
+  if (header.binary || header.problem) return read_csv_in_pieces(file, path, options);
+
+  const std::size_t size = file.size();
+  const auto start_of = [&](int k) -> long long {
+    if (k == 0) return static_cast<long long>(header.rows_begin);
+    if (k == parts) return static_cast<long long>(size);
+    const std::size_t even = size / static_cast<std::size_t>(parts) * static_cast<std::size_t>(k) +
+                             size % static_cast<std::size_t>(parts) * static_cast<std::size_t>(k) / static_cast<std::size_t>(parts);
+    const long long start = line_start_at_or_after(file, even);
+    return start < 0 ? start : std::max(start, static_cast<long long>(header.rows_begin));
+  };
+  const long long start = start_of(part), end = start_of(part + 1);
+  if (start < 0 || end < 0) return data_diag::cannot_open(path, std::strerror(static_cast<int>(-std::min(start, end))));
+  if (part > 0) parser.restart_lines(1);
+  const auto from = static_cast<std::size_t>(start), to = static_cast<std::size_t>(std::max(start, end));
+  RowsRead rows = read_rows(file, path, parser, from, to, part == parts - 1, true, options);
+  if (rows.failure) return *rows.failure;
+
+  // Every part's counts and outcome, in part order.
+  enum Count { kProblem, kNul, kNulNewlines, kNulColumn, kRows, kLines, kNewlines, kFrom, kTo, kRead, kFields };
+  std::vector<double> counts(kFields);
+  counts[kProblem] = rows.problem ? 1 : 0;
+  counts[kNul] = rows.nul ? 1 : 0;
+  counts[kNulNewlines] = static_cast<double>(rows.nul_newlines + (part == 0 ? header.newlines_before_rows : 0));
+  counts[kNulColumn] = rows.nul_column;
+  counts[kRows] = static_cast<double>(parser.record().rows());
+  counts[kLines] = parser.lines_read();
+  counts[kNewlines] = static_cast<double>(rows.newlines + (part == 0 ? header.newlines_before_rows : 0));
+  counts[kFrom] = static_cast<double>(from);
+  counts[kTo] = static_cast<double>(to);
+  counts[kRead] = static_cast<double>(rows.read);
+  const auto append = [](std::vector<double>& left, const std::vector<double>& right) { left.insert(left.end(), right.begin(), right.end()); };
+  if (auto c = share.merge(counts, append, false); c.outcome != PartShare::Outcome::combined)
+    return diag::error("stopped", {}, c.why.empty() ? "another process stopped" : c.why);
+  const auto at = [&](int k, Count f) { return counts[static_cast<std::size_t>(k) * kFields + f]; };
+
+  // A file that changed while read: a part read fewer bytes than its range holds, or the last more.
+  std::size_t read = header.rows_begin;
+  bool changed = false;
+  for (int k = 0; k < parts; ++k) {
+    read += static_cast<std::size_t>(at(k, kRead));
+    if (k + 1 < parts && at(k, kRead) != at(k, kTo) - at(k, kFrom)) changed = true;
+  }
+  if (changed || read != size) return data_diag::changed_while_read(path, changed_while_read(size, read).reason);
+  double newlines_before = 0, lines_before = 0;
+  for (int k = 0; k < parts; ++k) {
+    if (at(k, kNul) != 0)
+      return data_diag::binary_file(path, static_cast<int>(1 + newlines_before + at(k, kNulNewlines)), static_cast<int>(at(k, kNulColumn)));
+    newlines_before += at(k, kNewlines);
+  }
+  for (int k = 0; k < parts; ++k) {
+    if (at(k, kProblem) != 0) {
+      // Parsed again here, its lines numbered as in the file, so that every part names the problem
+      // as one process does.
+      CsvParser again(std::string_view(), path, options);
+      if (auto h = read_header(file, path, again); h.failure || h.binary || h.problem) return read_csv_in_pieces(file, path, options);
+      if (k > 0) again.restart_lines(1 + static_cast<int>(lines_before));
+      CsvOptions quiet = options;
+      quiet.progress = nullptr;
+      RowsRead redo = read_rows(file, path, again, static_cast<std::size_t>(at(k, kFrom)), static_cast<std::size_t>(at(k, kTo)), false, true, quiet);
+      if (redo.failure) return *redo.failure;
+      if (redo.problem) return *redo.problem;
+      return data_diag::changed_while_read(path, "its rows read differently the second time");
+    }
+    lines_before += at(k, kLines);
+  }
+
+  // The columns, in part order, and the bookkeeping shifted by the rows and lines before.
+  Record& record = parser.record();
+  std::vector<std::size_t> lengths(static_cast<std::size_t>(parts));
+  std::size_t total = 0;
+  for (int k = 0; k < parts; ++k) total += lengths[static_cast<std::size_t>(k)] = static_cast<std::size_t>(at(k, kRows));
+  std::vector<double> bookkeeping = bookkeeping_state(record.rows(), parser.lines_read(), record.first_faults, record.line_jumps);
+  const auto join = [](std::vector<double>& left, const std::vector<double>& right) {
+    Bookkeeping l = bookkeeping_of(left), r = bookkeeping_of(right);
+    append_later_rows(l.faults, l.jumps, l.rows, l.lines, std::move(r.faults), r.jumps);
+    left = bookkeeping_state(l.rows + r.rows, l.lines + r.lines, l.faults, l.jumps);
+  };
+  if (auto c = share.merge(bookkeeping, join, false); c.outcome != PartShare::Outcome::combined)
+    return diag::error("stopped", {}, c.why.empty() ? "another process stopped" : c.why);
+  Bookkeeping whole = bookkeeping_of(bookkeeping);
+  record.first_faults = std::move(whole.faults);
+  record.line_jumps = std::move(whole.jumps);
+  for (auto& column : record.columns) {
+    std::vector<double> all(total);
+    share.concatenate(column, all, lengths);
+    column = Column(std::move(all));
+  }
   return parser.finish();
 }
 
@@ -770,6 +1047,7 @@ std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOpti
   auto opened = open_regular_file(path);
   if (auto* refusal = std::get_if<FileRefusal>(&opened)) return refused(path, *refusal);
   const OpenFile& file = std::get<OpenFile>(opened);
+  if (options.share && options.share->parts() > 1) return read_csv_by_parts(file, path, options);
   if (options.chunk_bytes > 0 && file.size() > options.chunk_bytes) return read_csv_in_pieces(file, path, options);
   auto read = read_open_file(file.descriptor(), file.size());
   if (auto* refusal = std::get_if<FileRefusal>(&read)) return refused(path, *refusal);

@@ -40,6 +40,7 @@
 #include "diagnostics/diagnostic.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "runtime/records/column.hpp"
+#include "runtime/records/part_share.hpp"
 
 namespace sidc {
 
@@ -94,11 +95,16 @@ struct CsvOptions {
   // Called after each piece of a file read in pieces, with the bytes read and the file's size (a
   // progress line: cli/progress_line.hpp). Never called for a file read whole.
   std::function<void(std::size_t bytes_read, std::size_t total)> progress;
+  // Cooperating processes that read the file together (the ranks of `mpirun -np N sidc fit`, issue
+  // 17; not owned): each reads and parses one byte range, from a line start, and every one ends with
+  // the whole record, or the diagnostic, that one process reading the file alone gets. Null: alone.
+  PartShare* share = nullptr;
 
   bool is_valid(std::string* why = nullptr) const;
 };
 
-// Reads a file (whole, or piece by piece above CsvOptions::chunk_bytes) and parses it.
+// Reads a file (whole, or piece by piece above CsvOptions::chunk_bytes, or by the parts of
+// CsvOptions::share, each its own byte range) and parses it.
 std::variant<Record, Diagnostic> read_csv(const std::string& path, const CsvOptions& options = {});
 
 // The same, on text already in memory; `path` is only used in diagnostics.

@@ -2,9 +2,9 @@
 // share of the rows into its own triangular factor, and the factors are merged (TSQR: Demmel,
 // Grigori, Hoemmen, Langou 2008), so that every part goes on with the factor of all the rows.
 //
-// Relies on: triangular_accumulator.hpp (the factor and its exact state as doubles). The runtime
-// knows nothing of how the parts talk: distributed/mpi_row_share.hpp implements this over MPI.
-// Guarantees (of every implementation):
+// Relies on: part_share.hpp (merge(), its outcomes), triangular_accumulator.hpp (the factor and its
+// exact state as doubles). distributed/session.cpp implements this over MPI.
+// Guarantees (of every implementation), beside PartShare's:
 // - merge(), sum() and combine() are collective: every part calls them the same number of times, in
 //   the same order (fit.cpp combines once per streamed group, weak_design.cpp sums once per
 //   operation and order of the test function, select's streamed_rows.cpp merges once per record).
@@ -22,28 +22,13 @@
 #include <string>
 #include <vector>
 
+#include "runtime/records/part_share.hpp"
 #include "runtime/solve/triangular_accumulator.hpp"
 
 namespace sidc {
 
-class RowShare {
+class RowShare : public PartShare {
  public:
-  virtual ~RowShare() = default;
-  virtual int part() const = 0;   // 0 .. parts() - 1
-  virtual int parts() const = 0;  // at least 1
-
-  enum class Outcome { combined, problem, stopped };
-  struct Combined {
-    Outcome outcome = Outcome::combined;
-    std::string why;  // for `stopped`
-  };
-  // `left` becomes the state of left's rows followed by right's (right's parts come right after
-  // left's, so pieces that must join in order, such as a line fit's running differences, can).
-  using Merge = std::function<void(std::vector<double>& left, const std::vector<double>& right)>;
-
-  // Every part's `state` merged in part order, by a binary tree of merge(left, right) (the same tree
-  // for the same number of parts), and the result given to every part. States may differ in length.
-  virtual Combined merge(std::vector<double>& state, const Merge& merge, bool has_problem) = 0;
   // Element-wise sums of `values` over the parts, on every part (weak_design.cpp: each subdomain's
   // integral computed by one part, zeros from the others, so the sums are exact).
   virtual Combined sum(std::span<double> values, bool has_problem) = 0;

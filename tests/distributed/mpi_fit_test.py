@@ -10,9 +10,12 @@ case keeps the design in memory, as instrumental variables need) so that the ran
 - fit.json's estimates and standard errors equal to the single process's to 1e-12 relative (of the
   group's largest estimate), its statistics (G, n, rank) alike;
 - nothing on stdout from the ranks above 0 (one report, not N).
-Then the faults: a rank whose record is broken (MPMD: rank 1 started in another directory) stops
-the whole job with exit 1 and that rank's error (file, row, column), and no file is written; a
-job whose ranks all meet the same error prints it once. Without mpirun nothing names processes.
+Every record is read by byte ranges, one per rank (CsvOptions::share), so every case also checks
+that the ranks put the record together as one process reads it. Then the faults: a rank that
+cannot read the record (MPMD: rank 1 started in a directory without it) stops the whole job with
+exit 1 and that rank's error, and no file is written; a broken cell, a short row and a NUL byte in
+the last rank's range are named once, as one process names them. Without mpirun nothing names
+processes.
 
 Usage: mpi_fit_test.py SIDC MPIEXEC REPO
 """
@@ -142,33 +145,51 @@ try:
                 failures.append(f"{tag}: reports differ:\n" + "\n".join(diff[:5]))
         print(f"checked: {label}", flush=True)
 
-    # Faults. Rank 1 runs in a copy of the example whose record has a broken cell in y on line 41.
+    # Faults met by one rank alone: rank 1 runs where the record is missing (a node that does not
+    # see the file). The job stops with exit 1, rank 1's error shown with its rank, rank 0 saying
+    # why it stopped, and no output directory.
     good = os.path.join(work, "good")
-    bad = os.path.join(work, "bad")
+    lost = os.path.join(work, "lost")
     shutil.copytree(os.path.join(examples, "thesis-4-1"), good)
-    shutil.copytree(os.path.join(examples, "thesis-4-1"), bad)
-    with open(os.path.join(bad, "appendix_a.csv")) as f:
-        lines = f.read().splitlines(keepends=True)
-    fields = lines[40].split(",")
-    fields[1] = "oops"  # y, an output
-    lines[40] = ",".join(fields)
-    with open(os.path.join(bad, "appendix_a.csv"), "w") as f:
-        f.writelines(lines)
+    shutil.copytree(os.path.join(examples, "thesis-4-1"), lost)
+    os.remove(os.path.join(lost, "appendix_a.csv"))
     out = os.path.join(work, "fault-out")
     fault = run([mpiexec, "-np", "1", "--wdir", good, sidc, "fit", "system_4_1_1.sid", "--stream-above", "0", "--out", out, ":",
-                 "-np", "1", "--wdir", bad, sidc, "fit", "system_4_1_1.sid", "--stream-above", "0", "--out", out], good)
+                 "-np", "1", "--wdir", lost, sidc, "fit", "system_4_1_1.sid", "--stream-above", "0", "--out", out], good)
     if fault.returncode != 1:
         failures.append(f"fault: exit {fault.returncode}, expected 1: {fault.stderr[-800:]}")
-    if "[rank 1]" not in fault.stderr or "appendix_a.csv:41:" not in fault.stderr:
-        failures.append(f"fault: rank 1's error (file:row:column) not shown: {fault.stderr[-800:]}")
+    if "[rank 1]" not in fault.stderr or "appendix_a.csv" not in fault.stderr:
+        failures.append(f"fault: rank 1's error not shown: {fault.stderr[-800:]}")
     if "rank 1 of the 2 MPI processes stopped" not in fault.stderr:
         failures.append(f"fault: rank 0 does not say the job stopped for rank 1: {fault.stderr[-800:]}")
     if os.path.exists(out):
         failures.append("fault: an output directory was written although a rank failed")
-    # Every rank meets the same error: printed once.
-    same = run([mpiexec, "-np", "2", sidc, "fit", "system_4_1_1.sid", "--stream-above", "0"], bad)
-    if same.returncode != 1 or same.stderr.count("appendix_a.csv:41:") != 1 or "[rank" in same.stderr:
-        failures.append(f"same fault on every rank: exit {same.returncode}, stderr {same.stderr[-800:]!r}")
+    # Faults in the file all ranks read, late in it (in the last rank's byte range): a broken cell,
+    # a row with too few fields (parsed again by every rank with the file's line numbers) and a NUL
+    # byte (its row counted over the ranks before). Each named once, by file, row and column, exactly
+    # as one process names it, with exit 1.
+    with open(os.path.join(good, "appendix_a.csv"), newline="") as f:
+        lines = f.read().splitlines(keepends=True)
+    broken = {"bad cell": lambda row: ",".join([row.split(",")[0], "oops"] + row.split(",")[2:]),
+              "too few fields": lambda row: ",".join(row.split(",")[:2]) + "\n",
+              "NUL byte": lambda row: row[:3] + "\0" + row[3:]}
+    for what, change in broken.items():
+        folder = os.path.join(work, what.replace(" ", "_"))
+        shutil.copytree(os.path.join(examples, "thesis-4-1"), folder)
+        changed = list(lines)
+        changed[-3] = change(changed[-3])
+        with open(os.path.join(folder, "appendix_a.csv"), "w", newline="") as f:
+            f.writelines(changed)
+        one = run([sidc, "fit", "system_4_1_1.sid", "--stream-above", "0"], folder)
+        named = [line for line in one.stderr.splitlines() if "appendix_a.csv:" in line]
+        if one.returncode != 1 or len(named) != 1:
+            failures.append(f"{what}: one process: exit {one.returncode}, stderr {one.stderr[-400:]!r}")
+            continue
+        for n in (2, 3):
+            many = run([mpiexec, "-np", str(n), sidc, "fit", "system_4_1_1.sid", "--stream-above", "0"], folder)
+            shown = [line for line in many.stderr.splitlines() if "appendix_a.csv:" in line]
+            if many.returncode != 1 or shown != named or "[rank" in many.stderr:
+                failures.append(f"{what}, -np {n}: exit {many.returncode}, expected {named!r}, stderr {many.stderr[-600:]!r}")
     # A command other than fit under mpirun: rank 0 alone does it (one output, not two).
     compiled = run([mpiexec, "-np", "2", sidc, "compile", "system_4_1_1.sid"], good)
     if compiled.returncode != 0 or compiled.stdout.count("# system_4_1_1.sid:") != 1:

@@ -4,7 +4,9 @@
 // texts made here to put a piece's end everywhere: CRLF and CR line ends, comments and blank lines
 // between rows, a byte-order mark, spreadsheet rows of empty cells, faulty cells late in the file,
 // a NUL byte after a bad row, a last line without its line end; pieces of 1 byte to larger than the
-// file, on one thread and (parallel_above_bytes small) on two within each piece.
+// file, on one thread and (parallel_above_bytes small) on two within each piece. And the same file
+// read by 2, 3 and 5 parts (CsvOptions::share; threads here, MPI ranks under mpirun), each its own
+// byte range: every part ends with the same record, or the same diagnostic, as one reader alone.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,6 +21,7 @@
 #include <unistd.h>
 
 #include "runtime/records/records.hpp"
+#include "support/thread_share.hpp"
 
 namespace sidc {
 namespace {
@@ -57,6 +60,29 @@ void expect_same_in_pieces(const std::string& path) {
   }
 }
 
+// Every part's record (described) when `parts` parts read the file together in pieces of `chunk` bytes.
+std::vector<std::string> read_by_parts(const std::string& path, int parts, std::size_t chunk) {
+  ThreadRoom room(parts);
+  return in_parts(room, [&](RowShare& share, int) {
+    CsvOptions o;
+    o.chunk_bytes = chunk;
+    o.share = &share;
+    return describe(read_csv(path, o));
+  });
+}
+
+void expect_same_by_parts(const std::string& path) {
+  CsvOptions whole;
+  whole.chunk_bytes = 0;
+  const std::string expected = describe(read_csv(path, whole));
+  for (const int parts : {2, 3, 5})
+    for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, std::size_t{1000}}) {
+      const auto results = read_by_parts(path, parts, chunk);
+      for (std::size_t k = 0; k < results.size(); ++k)
+        ASSERT_EQ(results[k], expected) << path << ": part " << k << " of " << parts << ", pieces of " << chunk << " bytes";
+    }
+}
+
 TEST(RecordsInPieces, EveryRecordFileOfTheProjectReadsTheSame) {
   std::size_t files = 0;
   for (const char* folder : {"/tests/data/bad", "/tests/runtime/data", "/examples"}) {
@@ -65,6 +91,7 @@ TEST(RecordsInPieces, EveryRecordFileOfTheProjectReadsTheSame) {
       if (!entry.is_regular_file() || (ext != ".csv" && ext != ".tsv" && ext != ".txt") || fs::file_size(entry.path()) > (1u << 18)) continue;
       SCOPED_TRACE(entry.path().string());
       expect_same_in_pieces(entry.path().string());
+      expect_same_by_parts(entry.path().string());
       ++files;
     }
   }
@@ -85,7 +112,7 @@ class TextFile {
   std::string path_;
 };
 
-TEST(RecordsInPieces, TextsThatPutAPieceEndEverywhere) {
+TEST(RecordsInPieces, TextsThatPutAPieceEndOrAPartBoundaryEverywhere) {
   const std::vector<std::string> texts = {
       "t,x,y\n0,1,2\n1,2,3\n2,3,4\n3,4,5\n4,5,6\n",
       "t,x,y\r\n0,1,2\r\n1,2,3\r\n2,3,4\r\n",                                  // CRLF
@@ -106,6 +133,7 @@ TEST(RecordsInPieces, TextsThatPutAPieceEndEverywhere) {
     SCOPED_TRACE(k);
     const TextFile file(texts[k]);
     expect_same_in_pieces(file.path());
+    expect_same_by_parts(file.path());
   }
 }
 
@@ -140,6 +168,7 @@ TEST(RecordsInPieces, RandomTexts) {
     const TextFile file(text);
     SCOPED_TRACE(text);
     expect_same_in_pieces(file.path());
+    expect_same_by_parts(file.path());
   }
 }
 

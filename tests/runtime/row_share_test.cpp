@@ -6,7 +6,6 @@
 // one process names it. The accumulator's state must travel exactly.
 #include <gtest/gtest.h>
 
-#include <barrier>
 #include <cmath>
 #include <random>
 #include <span>
@@ -19,86 +18,11 @@
 #include "runtime/solve/triangular_accumulator.hpp"
 
 #include "support/shell.hpp"
+#include "support/thread_share.hpp"
 #include "support/thesis_record.hpp"
 
 namespace sidc {
 namespace {
-
-// The parts' meeting room: each part leaves its state, all wait, each merges all states in part
-// order (so every part computes the same bits), all wait again before the room is reused.
-struct ThreadRoom {
-  explicit ThreadRoom(int n) : parts(n), barrier(n), states(static_cast<std::size_t>(n)), values(static_cast<std::size_t>(n)),
-                               problems(static_cast<std::size_t>(n)) {}
-  int parts;
-  std::barrier<> barrier;
-  std::vector<std::vector<double>> states, values;
-  std::vector<char> problems;
-  int problem_rounds = 0;  // combines that found a problem in some part's rows (counted by part 0)
-  int sums = 0;            // sum() calls (counted by part 0)
-};
-
-class ThreadShare final : public RowShare {
- public:
-  ThreadShare(ThreadRoom& room, int part) : room_(room), part_(part) {}
-  int part() const override { return part_; }
-  int parts() const override { return room_.parts; }
-  // Merged left to right in part order (MPI's share merges by a tree: the same to rounding).
-  Combined merge(std::vector<double>& state, const Merge& merge_two, bool has_problem) override {
-    const auto me = static_cast<std::size_t>(part_);
-    room_.states[me] = state;
-    room_.problems[me] = has_problem ? 1 : 0;
-    room_.barrier.arrive_and_wait();
-    Combined result;
-    if (std::any_of(room_.problems.begin(), room_.problems.end(), [](char p) { return p != 0; })) {
-      result.outcome = Outcome::problem;
-      if (part_ == 0) ++room_.problem_rounds;
-    } else {
-      std::vector<double> merged = room_.states[0];
-      for (std::size_t k = 1; k < room_.states.size(); ++k) merge_two(merged, room_.states[k]);
-      state = merged;
-    }
-    room_.barrier.arrive_and_wait();
-    return result;
-  }
-
-  Combined sum(std::span<double> values, bool has_problem) override {
-    const auto me = static_cast<std::size_t>(part_);
-    room_.values[me].assign(values.begin(), values.end());
-    room_.problems[me] = has_problem ? 1 : 0;
-    room_.barrier.arrive_and_wait();
-    Combined result;
-    if (part_ == 0) ++room_.sums;
-    if (std::any_of(room_.problems.begin(), room_.problems.end(), [](char p) { return p != 0; })) {
-      result.outcome = Outcome::problem;
-    } else {
-      for (std::size_t j = 0; j < values.size(); ++j) {
-        double total = 0;
-        for (const auto& v : room_.values) total += v[j];
-        values[j] = total;
-      }
-    }
-    room_.barrier.arrive_and_wait();
-    return result;
-  }
-
- private:
-  ThreadRoom& room_;
-  int part_;
-};
-
-// run(share, k) for every part k of the room, the parts side by side as threads; their results.
-template <class Run>
-auto in_parts(ThreadRoom& room, Run run) {
-  using Result = decltype(run(std::declval<RowShare&>(), 0));
-  std::vector<ThreadShare> shares;
-  for (int k = 0; k < room.parts; ++k) shares.emplace_back(room, k);
-  std::vector<Result> results(static_cast<std::size_t>(room.parts));
-  std::vector<std::thread> threads;
-  for (int k = 0; k < room.parts; ++k)
-    threads.emplace_back([&, k] { results[static_cast<std::size_t>(k)] = run(shares[static_cast<std::size_t>(k)], k); });
-  for (auto& t : threads) t.join();
-  return results;
-}
 
 // Every part's fit.
 std::vector<std::variant<FitSummary, Diagnostic>> fit_in_parts(const ir::Model& m, const std::vector<SampledRecord>& records,

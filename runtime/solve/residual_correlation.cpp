@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "runtime/parallel_ranges.hpp"
+
 namespace sidc {
 namespace {
 
@@ -80,6 +82,18 @@ long double lagged_sum(const std::vector<std::vector<double>>& a, const std::vec
     for (long t = first; t < last; ++t) sum += static_cast<long double>(a[s][t + k]) * b[s][t];
   }
   return sum;
+}
+
+// lagged_sum(a, b, k) for k = first, ..., last, the lags shared among the cores: each sum is made
+// exactly as one thread makes it, so the values do not depend on the number of cores.
+std::vector<long double> lagged_sums(const std::vector<std::vector<double>>& a, const std::vector<std::vector<double>>& b, int first, int last) {
+  std::vector<long double> out(static_cast<std::size_t>(last - first + 1));
+  std::size_t n = 0;
+  for (const auto& segment : a) n += segment.size();
+  for_parallel_ranges(out.size(), n * out.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out[i] = lagged_sum(a, b, first + static_cast<int>(i));
+  });
+  return out;
 }
 
 // skip_zero: an autocorrelation (lag 0 is 1 by construction); its clean verdict is "looks white",
@@ -267,9 +281,10 @@ ResidualCorrelationSummary residual_correlation(const std::vector<std::vector<do
   summary.bonferroni_band = two_sided_z(alpha / max_lag) / root_n;
 
   auto& ac = summary.autocorrelation;
+  const std::vector<long double> auto_sums = lagged_sums(e, e, 0, max_lag);
   for (int k = 0; k <= max_lag; ++k) {
     ac.lags.push_back(k);
-    ac.values.push_back(static_cast<double>(lagged_sum(e, e, k) / r0));
+    ac.values.push_back(static_cast<double>(auto_sums[static_cast<std::size_t>(k)] / r0));
   }
   ac.computed = true;
   judge(ac, summary.band, summary.bonferroni_band, binomial_allowance(max_lag, alpha, alpha), true);
@@ -294,9 +309,10 @@ ResidualCorrelationSummary residual_correlation(const std::vector<std::vector<do
       continue;
     }
     const long double norm = std::sqrt(r0 * u0);
+    const std::vector<long double> cross_sums = lagged_sums(e, u, -max_lag, max_lag);
     for (int k = -max_lag; k <= max_lag; ++k) {
       curve.lags.push_back(k);
-      curve.values.push_back(static_cast<double>(lagged_sum(e, u, k) / norm));
+      curve.values.push_back(static_cast<double>(cross_sums[static_cast<std::size_t>(k + max_lag)] / norm));
     }
     curve.computed = true;
     judge(curve, summary.band, cross_bonferroni, cross_allowance, false);

@@ -137,6 +137,39 @@ TEST(RecordsInPieces, TextsThatPutAPieceEndOrAPartBoundaryEverywhere) {
   }
 }
 
+// Pieces of 1 MiB and more are read ahead on a thread while the one before is parsed (read_rows):
+// texts of a few MB, clean and with a late fault, a late bad row, a late NUL byte, CRLF ends.
+TEST(RecordsInPieces, LargePiecesReadAheadAsTheWholeFileReads) {
+  std::string rows;
+  for (int i = 0; i < 80000; ++i) rows += std::to_string(i) + "," + std::to_string(i * 0.001) + "," + std::to_string(i % 97) + "\n";
+  const std::size_t late = rows.size() - 1000;
+  const std::size_t late_line = rows.find('\n', late) + 1;  // a line start near the end
+  std::vector<std::string> texts = {"t,x,y\n" + rows};
+  texts.push_back("t,x,y\n" + rows.substr(0, late_line) + "7,abc,8\n" + rows.substr(late_line));     // a faulty cell
+  texts.push_back("t,x,y\n" + rows.substr(0, late_line) + "7,8\n" + rows.substr(late_line));         // too few fields
+  texts.push_back("t,x,y\n" + rows.substr(0, late_line) + std::string("7,\0,8\n", 6) + rows.substr(late_line));  // a NUL byte
+  std::string crlf = "t,x,y\r\n";
+  for (std::size_t i = 0, j; i < rows.size(); i = j + 1) {
+    j = rows.find('\n', i);
+    crlf += rows.substr(i, j - i) + "\r\n";
+  }
+  texts.push_back(crlf);
+  for (std::size_t k = 0; k < texts.size(); ++k) {
+    SCOPED_TRACE(k);
+    const TextFile file(texts[k]);
+    CsvOptions whole;
+    whole.chunk_bytes = 0;
+    const std::string expected = describe(read_csv(file.path(), whole));
+    for (const std::size_t chunk : {std::size_t{1} << 20}) {
+      CsvOptions pieces;
+      pieces.chunk_bytes = chunk;
+      EXPECT_EQ(describe(read_csv(file.path(), pieces)), expected) << "pieces of " << chunk << " bytes";
+      for (const int parts : {2, 3})
+        for (const auto& result : read_by_parts(file.path(), parts, chunk)) EXPECT_EQ(result, expected) << parts << " parts";
+    }
+  }
+}
+
 TEST(RecordsInPieces, ProgressHearsEachPieceUpToTheWholeFile) {
   std::string text = "t,x\n";
   for (int i = 0; i < 1000; ++i) text += std::to_string(i) + "," + std::to_string(i * 0.5) + "\n";

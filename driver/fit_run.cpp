@@ -253,7 +253,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     // The fitted records, then those given only to be compared with (not copied: records can be long).
     std::vector<SampledRecord>& extra = run.validated_only;
     for (auto& input : run.settings.validate) {
-      auto record = load_record(model, std::move(input), run.loaded.bind);
+      auto record = load_record(model, std::move(input), run.loaded.bind, run.settings.records.share);
       if (auto* d = std::get_if<Diagnostic>(&record)) return failure(*d);
       extra.push_back(std::get<SampledRecord>(std::move(record)));
     }

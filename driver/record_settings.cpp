@@ -111,9 +111,9 @@ std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compil
   return out;
 }
 
-std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind) {
+std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind, PartShare* share) {
   const ir::DataSource source = source_of(model, input);
-  return read_and_bind(std::move(input), source, model, bind);
+  return read_and_bind(std::move(input), source, model, bind, nullptr, share);
 }
 
 }  // namespace sidc::driver

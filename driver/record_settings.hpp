@@ -61,7 +61,9 @@ std::variant<LoadedRecords, Diagnostic> load_records(
     const CompiledModel& compiled, const std::string& directory, std::vector<RecordInput> inputs, const RecordSettings& settings,
     const std::function<void(const std::string& phase, std::size_t done, std::size_t total)>& progress = nullptr);
 
-// One more record, bound like the others as the model's first data statement.
-std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind);
+// One more record, bound like the others as the model's first data statement (read by `share`'s
+// processes together when given, as load_records reads with RecordSettings::share).
+std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind,
+                                                    PartShare* share = nullptr);
 
 }  // namespace sidc::driver

@@ -745,7 +745,9 @@ HeaderRead read_header(const OpenFile& file, const std::string& path, CsvParser&
       return out;
     }
     prefix = std::string_view(text.get(), static_cast<std::size_t>(got));
-    if (static_cast<std::size_t>(got) < want || want >= file.size() || parser.holds_first_line(prefix)) break;
+    if (static_cast<std::size_t>(got) < want || want >= file.size() || parser.holds_first_line(prefix) ||
+        std::memchr(prefix.data(), '\0', prefix.size()))  // a binary file: no need to read on for a line end
+      break;
     want = std::min(file.size(), 2 * want);
   }
   out.read = prefix.size();
@@ -916,12 +918,14 @@ std::variant<Record, Diagnostic> read_csv_in_pieces(const OpenFile& file, const 
   CsvParser parser(std::string_view(), path, options);
   const HeaderRead header = read_header(file, path, parser);
   if (header.failure) return *header.failure;
-  if (header.binary) return *header.binary;
-  // After a problem in the first lines nothing more is parsed, but a NUL byte anywhere comes first.
-  const std::size_t from = header.problem ? header.read : header.rows_begin;
-  const RowsRead rows = read_rows(file, path, parser, from, file.size(), true, !header.problem, options);
+  // After a NUL byte or a problem in the first lines nothing more is parsed, but the rest is still
+  // read: a file that changed comes first, and a NUL byte anywhere before a problem.
+  const bool stopped = header.binary || header.problem;
+  const std::size_t from = stopped ? header.read : header.rows_begin;
+  const RowsRead rows = read_rows(file, path, parser, from, file.size(), true, !stopped, options);
   if (rows.failure) return *rows.failure;
   if (from + rows.read != file.size()) return data_diag::changed_while_read(path, changed_while_read(file.size(), from + rows.read).reason);
+  if (header.binary) return *header.binary;
   const std::size_t newlines_before = header.problem ? header.newlines : header.newlines_before_rows;
   if (rows.nul) return data_diag::binary_file(path, static_cast<int>(1 + newlines_before + rows.nul_newlines), rows.nul_column);
   if (header.problem) return *header.problem;

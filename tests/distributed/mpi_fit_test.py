@@ -49,9 +49,9 @@ def normalised(report):
             line = line[: line.index(" on ")] + " on (threads or ranks)"
         line = re.sub(r"\b[0-9.]+(e-?[0-9]+)? s\b", "(seconds)", line)  # the searches' times
         if "(estimated by least squares over the first" in line:
-            # The validation's initial state: Levenberg-Marquardt on forward differences, converged
-            # to about 1e-7 (runtime/simulate/initial_state.hpp), so estimates equal to 1e-12 can move
-            # its sixth printed digit; compared to four.
+            # The validation's initial state: where the start segment determines it poorly (the
+            # drift example), estimates equal to 1e-12 move it by about 1e-7, and its sixth printed
+            # digit with it (docs/distributed.md, "Exactness"); compared to four.
             line = re.sub(r"-?[0-9]+\.[0-9]+(e-?[0-9]+)?", lambda m: f"{float(m.group()):.4g}", line)
         lines.append(line)
     return "\n".join(lines)

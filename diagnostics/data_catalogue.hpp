@@ -1,7 +1,8 @@
 // Every message sidc prints about a data file (a record), one named constructor each, the data
-// counterpart of diagnostics/model_catalogue.hpp. records.cpp and sampling.cpp build
-// Diagnostics only through these, so the wording lives in one place and the bad-record tests
-// (tests/runtime/bad_records_test.cpp, files in tests/data/bad/) pin every one of them.
+// counterpart of diagnostics/model_catalogue.hpp. runtime/records/ (csv_file.cpp, csv_parser.cpp,
+// records.cpp) and sampling.cpp build Diagnostics only through these, so the wording lives in one
+// place and the bad-record tests (tests/runtime/bad_records_test.cpp, files in tests/data/bad/) pin
+// every one of them.
 //
 // Locations are `file:row:col` with row = 1-based line number in the file (comments, blank lines
 // and the header count) and col = 1-based field index on that line. Codes are stable: tests rely
@@ -28,7 +29,7 @@ enum class CellFault : unsigned char {
   out_of_range,   // beyond the range of a double (1e400)
 };
 
-// ---- the file as a whole (records.cpp) ---------------------------------------------------------
+// ---- the file as a whole (csv_file.cpp, csv_parser.cpp) -----------------------------------------
 Diagnostic cannot_open(std::string_view path, std::string_view reason);
 Diagnostic is_directory(std::string_view path);
 // A FIFO, a device or a socket named as a record; `what`: "a FIFO", "a character device", ...
@@ -40,11 +41,11 @@ Diagnostic binary_file(std::string_view path, int row, int column);
 Diagnostic no_data_rows(std::string_view path, int header_row);
 Diagnostic invalid_csv_options(std::string_view why);
 
-// ---- the header (records.cpp) ------------------------------------------------------------------
+// ---- the header (csv_parser.cpp) ---------------------------------------------------------------
 Diagnostic unterminated_quote(std::string_view path, int row, int column);
 Diagnostic duplicate_column(std::string_view path, int row, int column, std::string_view name, int first_column);
 
-// ---- row shape (records.cpp) -------------------------------------------------------------------
+// ---- row shape (csv_parser.cpp) ----------------------------------------------------------------
 Diagnostic too_many_fields(std::string_view path, int row, int column, std::size_t expected, bool blank_separated);
 Diagnostic too_few_fields(std::string_view path, int row, int column, std::size_t found, std::size_t expected,
                           bool blank_separated);

@@ -1,4 +1,4 @@
-// libFuzzer target: the CSV reader (runtime/records/records.cpp parse_csv) on text in memory.
+// libFuzzer target: the CSV reader (runtime/records/csv_parser.cpp, parse_csv) on text in memory.
 // The first byte chooses the options (separator, header, decimal comma, comment character,
 // one or two threads); the rest is the file.
 //

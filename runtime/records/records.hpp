@@ -93,7 +93,8 @@ struct CsvOptions {
   // record or diagnostic, is the whole file's. 0: always read whole.
   std::size_t chunk_bytes = std::size_t{16} << 20;
   // Called after each piece of a file read in pieces, with the bytes read and the file's size (a
-  // progress line: cli/progress_line.hpp). Never called for a file read whole.
+  // progress line: cli/progress_line.hpp); read by parts (`share`), with the offset reached in
+  // this part's byte range and the range's end. Never called for a file read whole.
   std::function<void(std::size_t bytes_read, std::size_t total)> progress;
   // Cooperating processes that read the file together (the ranks of `mpirun -np N sidc fit`, issue
   // 17; not owned): each reads and parses one byte range, from a line start, and every one ends with

@@ -621,12 +621,14 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
     }
     return std::nullopt;
   }
-  // Streamed: evaluate every block again, as stream_rows did, and apply the estimates.
+  // Streamed: evaluate every block again, as stream_rows did, and apply the estimates; a batch of
+  // blocks at a time on the cores (each block's rows as one thread makes them), handed on in order.
   const DesignBuilder design(model, records, g.equations);
   const auto p = static_cast<Eigen::Index>(design.columns().size());
   const std::size_t block_rows = std::max<std::size_t>(options.stream_block_rows, 1);
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(block_rows), p);
-  Eigen::VectorXd b(static_cast<Eigen::Index>(block_rows));
+  const std::size_t batch = 4 * static_cast<std::size_t>(core_count());  // blocks evaluated side by side
+  std::vector<std::vector<ResidualRow>> batch_rows(batch);
+  std::vector<std::optional<Diagnostic>> batch_problems(batch);
   std::size_t remaining = max_rows;  // rows per equation still wanted
   for (std::size_t r = 0; r < records.size() && remaining > 0; ++r) {
     auto chosen = operators_for_record(options.evaluation, records[r], model);
@@ -649,19 +651,33 @@ std::optional<Diagnostic> for_each_residual_block(const ir::Model& model, const 
       for (std::size_t begin = 0; begin < w.size(); begin += stretch) {
         const std::size_t end = std::min(w.size(), begin + stretch);
         if (auto problem = running.advance(end, 1, block_rows)) return problem;
-        BlockEvaluator evaluator(records[r], evaluation, w, running.values());
-        BlockValues values(evaluator, records[r], w, nullptr);
-        for (std::size_t start = begin; start < end; start += block_rows) {
-          const std::size_t m = std::min(block_rows, end - start);
-          const auto count = static_cast<Eigen::Index>(m);
-          evaluator.start_block(w.first + start, w.first + start + m);
-          A.setZero();
-          if (auto problem = design.equation_rows(r, e, values, {A.topRows(count), b.head(count)})) return problem;
-          const Eigen::VectorXd residuals = TriangularAccumulator::residuals_of(A.topRows(count), b.head(count), g.summary);
-          block.clear();
-          for (std::size_t i = 0; i < m; ++i)
-            block.push_back({e, r, records[r].time[w.first + start + i], b(static_cast<Eigen::Index>(i)), residuals(static_cast<Eigen::Index>(i))});
-          if (!rows(block)) return std::nullopt;
+        const std::size_t blocks = (end - begin + block_rows - 1) / block_rows;
+        for (std::size_t first_block = 0; first_block < blocks; first_block += batch) {
+          const std::size_t in_batch = std::min(batch, blocks - first_block);
+          const auto evaluate = [&](std::size_t from, std::size_t to) {
+            BlockEvaluator evaluator(records[r], evaluation, w, running.values());
+            BlockValues values(evaluator, records[r], w, nullptr);
+            Eigen::MatrixXd A(static_cast<Eigen::Index>(block_rows), p);
+            Eigen::VectorXd b(static_cast<Eigen::Index>(block_rows));
+            for (std::size_t k = from; k < to; ++k) {
+              const std::size_t start = begin + (first_block + k) * block_rows, m = std::min(block_rows, end - start);
+              const auto count = static_cast<Eigen::Index>(m);
+              evaluator.start_block(w.first + start, w.first + start + m);
+              A.setZero();
+              batch_rows[k].clear();
+              if ((batch_problems[k] = design.equation_rows(r, e, values, {A.topRows(count), b.head(count)}))) return;  // later blocks are not wanted
+              const Eigen::VectorXd residuals = TriangularAccumulator::residuals_of(A.topRows(count), b.head(count), g.summary);
+              for (std::size_t i = 0; i < m; ++i)
+                batch_rows[k].push_back({e, r, records[r].time[w.first + start + i], b(static_cast<Eigen::Index>(i)),
+                                         residuals(static_cast<Eigen::Index>(i))});
+            }
+          };
+          std::fill(batch_problems.begin(), batch_problems.end(), std::nullopt);
+          for_parallel_ranges(in_batch, in_batch * block_rows * static_cast<std::size_t>(p) * static_cast<std::size_t>(p), evaluate);
+          for (std::size_t k = 0; k < in_batch; ++k) {
+            if (batch_problems[k]) return batch_problems[k];
+            if (!rows(batch_rows[k])) return std::nullopt;
+          }
         }
       }
     }

@@ -225,6 +225,53 @@ TEST(StreamedFit, ResidualsInASecondPassMatchTheDenseOnes) {
   }
 }
 
+TEST(StreamedFit, ResidualsOfBlocksEvaluatedOnTheCoresMatchTheDenseOnes) {
+  // Blocks large enough, and a design wide enough, for the second pass to evaluate a batch of
+  // blocks on the cores (fit.cpp, for_each_residual_block): handed on in order, each as the dense fit has it.
+  const ir::Model m = compiled_text("library.sid", "input x\noutput y\nparam m, c[1..6], s[1..6], d[1..7]\n"
+                                                   "set derivative = savgol(7, 3)\n"
+                                                   "m*y'' + sum(k = 1..6, c[k]*y'^k) + sum(k = 1..6, s[k]*y^k) + sum(k = 1..7, d[k]*y^k*y') = x\n");
+  SampledRecord r;
+  r.path = "synthetic";
+  r.step = 0.001;
+  for (int k = 0; k < 60000; ++k) {
+    const double t = 0.001 * k;
+    r.time.push_back(t);
+    r.signals["x"].push_back(std::sin(1.3 * t) + 0.4 * std::cos(3.7 * t));
+    r.signals["y"].push_back(0.8 * std::sin(1.1 * t + 0.2) + 0.3 * std::sin(2.9 * t) + 1e-4 * std::cos(41.0 * t));
+  }
+  FitOptions stream_options;
+  stream_options.stream_above_entries = 0;
+  stream_options.stream_block_rows = 2048;
+  const FitSummary dense = fitted(m, {r}, {});
+  const FitSummary stream = fitted(m, {r}, stream_options);
+  std::vector<ResidualRow> a, b;
+  std::size_t handed = 0;
+  ASSERT_FALSE(for_each_residual_block(m, {r}, {}, dense, 0, [&](std::span<const ResidualRow> rows) {
+    a.insert(a.end(), rows.begin(), rows.end());
+    return true;
+  }));
+  ASSERT_FALSE(for_each_residual_block(m, {r}, stream_options, stream, 0, [&](std::span<const ResidualRow> rows) {
+    b.insert(b.end(), rows.begin(), rows.end());
+    ++handed;
+    return true;
+  }));
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_GT(handed, 16u);  // two batches of blocks at least
+  double largest = 0;
+  for (const auto& row : a) largest = std::max(largest, std::abs(row.residual));
+  ASSERT_GT(largest, 0);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].time, b[i].time) << "row " << i;
+    EXPECT_DOUBLE_EQ(a[i].known, b[i].known) << "row " << i;
+    EXPECT_NEAR(a[i].residual, b[i].residual, 1e-6 * largest) << "row " << i;
+  }
+  // Stopped after the first block: later batches are not handed on.
+  handed = 0;
+  ASSERT_FALSE(for_each_residual_block(m, {r}, stream_options, stream, 0, [&](std::span<const ResidualRow>) { return ++handed < 1; }));
+  EXPECT_EQ(handed, 1u);
+}
+
 TEST(StreamedFit, TheSameDiagnosticForAValueThatIsNotFinite) {
   // log(y) is NaN where y < 0: both paths must blame the same term at the same time.
   const ir::Model m = compiled_text("log.sid", "input x\noutput y\nparam a, b\nset to = 0.82\na*y' + b*log(y + 1) = x\n");

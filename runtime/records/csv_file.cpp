@@ -11,6 +11,7 @@
 #include <future>
 #include <memory>
 #include <new>
+#include <optional>
 #include <system_error>
 
 #include "diagnostics/regular_file.hpp"
@@ -77,12 +78,8 @@ HeaderRead read_header(const OpenFile& file, const std::string& path, CsvParser&
   }
   out.read = prefix.size();
   out.newlines = static_cast<std::size_t>(std::count(prefix.begin(), prefix.end(), '\n'));
-  if (const void* nul = std::memchr(prefix.data(), '\0', prefix.size())) {
-    const char* at = static_cast<const char*>(nul);
-    const char* line_start = at;
-    while (line_start > prefix.data() && *(line_start - 1) != '\n') --line_start;
-    const auto row = 1 + std::count(prefix.data(), at, '\n');
-    out.binary = data_diag::binary_file(path, static_cast<int>(row), static_cast<int>(at - line_start) + 1);
+  if (const auto nul = csv::first_nul(prefix.data(), prefix.data(), prefix.data() + prefix.size())) {
+    out.binary = data_diag::binary_file(path, static_cast<int>(1 + nul->newlines), nul->column);
     return out;
   }
   parser.set_text(prefix);
@@ -104,9 +101,7 @@ struct RowsRead {
   std::optional<Diagnostic> problem;  // the parser's first
   std::size_t read = 0;               // bytes read
   std::size_t newlines = 0;           // '\n' bytes among them, up to the first NUL
-  bool nul = false;                   // a NUL byte among them; the first one's
-  std::size_t nul_newlines = 0;       //   '\n' bytes before it (from `from` on)
-  int nul_column = 0;                 //   and column
+  std::optional<csv::NulByte> nul;    // the first NUL byte among them (its line ends counted from `from`)
 };
 
 // One read into `buffer` after the `held` bytes it keeps, and what read_rows notes of the new
@@ -114,9 +109,7 @@ struct RowsRead {
 struct Refill {
   long long got = 0;  // bytes read, or -errno
   std::size_t newlines = 0;
-  bool nul = false;
-  std::size_t nul_newlines = 0;
-  int nul_column = 0;
+  std::optional<csv::NulByte> nul;  // its line ends counted from the new bytes' start
 };
 
 Refill refill(const OpenFile& file, char* buffer, std::size_t held, std::size_t want, std::size_t offset, bool look_for_nul) {
@@ -125,17 +118,8 @@ Refill refill(const OpenFile& file, char* buffer, std::size_t held, std::size_t 
   if (r.got <= 0) return r;
   const char* first = buffer + held;
   const char* last = first + r.got;
-  const void* nul = look_for_nul ? std::memchr(first, '\0', static_cast<std::size_t>(r.got)) : nullptr;
-  if (!nul) {
-    r.newlines = static_cast<std::size_t>(std::count(first, last, '\n'));
-    return r;
-  }
-  const char* at = static_cast<const char*>(nul);
-  const char* line_start = at;
-  while (line_start > buffer && *(line_start - 1) != '\n') --line_start;
-  r.nul = true;
-  r.nul_newlines = static_cast<std::size_t>(std::count(first, at, '\n'));
-  r.nul_column = static_cast<int>(at - line_start) + 1;
+  if (look_for_nul) r.nul = csv::first_nul(buffer, first, last);
+  if (!r.nul) r.newlines = static_cast<std::size_t>(std::count(first, last, '\n'));
   return r;
 }
 
@@ -168,11 +152,7 @@ RowsRead read_rows(const OpenFile& file, const std::string& path, CsvParser& par
       out.failure = data_diag::cannot_open(path, std::strerror(static_cast<int>(-r.got)));
       return false;
     }
-    if (!out.nul && r.nul) {
-      out.nul = true;
-      out.nul_newlines = out.newlines + r.nul_newlines;
-      out.nul_column = r.nul_column;
-    }
+    if (!out.nul && r.nul) out.nul = csv::NulByte{out.newlines + r.nul->newlines, r.nul->column};
     if (!out.nul) out.newlines += r.newlines;
     at_end = r.got == 0;
     out.read += static_cast<std::size_t>(r.got);
@@ -252,7 +232,7 @@ std::variant<Record, Diagnostic> read_csv_in_pieces(const OpenFile& file, const 
   if (from + rows.read != file.size()) return data_diag::changed_while_read(path, changed_while_read(file.size(), from + rows.read).reason);
   if (header.binary) return *header.binary;
   const std::size_t newlines_before = header.problem ? header.newlines : header.newlines_before_rows;
-  if (rows.nul) return data_diag::binary_file(path, static_cast<int>(1 + newlines_before + rows.nul_newlines), rows.nul_column);
+  if (rows.nul) return data_diag::binary_file(path, static_cast<int>(1 + newlines_before + rows.nul->newlines), rows.nul->column);
   if (header.problem) return *header.problem;
   if (rows.problem) return *rows.problem;
   return parser.finish();
@@ -362,8 +342,8 @@ std::variant<Record, Diagnostic> read_csv_by_parts(const OpenFile& file, const s
   std::vector<double> counts(kFields);
   counts[kProblem] = rows.problem ? 1 : 0;
   counts[kNul] = rows.nul ? 1 : 0;
-  counts[kNulNewlines] = static_cast<double>(rows.nul_newlines + (part == 0 ? header.newlines_before_rows : 0));
-  counts[kNulColumn] = rows.nul_column;
+  counts[kNulNewlines] = rows.nul ? static_cast<double>(rows.nul->newlines + (part == 0 ? header.newlines_before_rows : 0)) : 0;
+  counts[kNulColumn] = rows.nul ? rows.nul->column : 0;
   counts[kRows] = static_cast<double>(parser.record().rows());
   counts[kLines] = parser.lines_read();
   counts[kNewlines] = static_cast<double>(rows.newlines + (part == 0 ? header.newlines_before_rows : 0));

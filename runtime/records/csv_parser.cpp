@@ -143,6 +143,15 @@ CellValue classify_cell(std::string_view text, bool decimal_comma) {
 // The bookkeeping of rows parsed apart (a second thread's, another process's) put after the rows
 // before them: `later`'s rows are numbered from 0 and its lines from 1; the `rows` and `lines`
 // before them shift both. Each column keeps its first kFaultsKeptPerColumn faulty cells.
+std::optional<NulByte> first_nul(const char* floor, const char* first, const char* last) {
+  const void* nul = std::memchr(first, '\0', static_cast<std::size_t>(last - first));
+  if (!nul) return std::nullopt;
+  const char* at = static_cast<const char*>(nul);
+  const char* line_start = at;
+  while (line_start > floor && *(line_start - 1) != '\n') --line_start;
+  return NulByte{static_cast<std::size_t>(std::count(first, at, '\n')), static_cast<int>(at - line_start) + 1};
+}
+
 void append_later_rows(std::vector<std::vector<FaultyCell>>& faults, std::vector<std::pair<std::size_t, int>>& jumps, std::size_t rows,
                        int lines, std::vector<std::vector<FaultyCell>> later_faults, const std::vector<std::pair<std::size_t, int>>& later_jumps) {
   for (std::size_t j = 0; j < faults.size() && j < later_faults.size(); ++j) {
@@ -461,13 +470,7 @@ std::optional<Diagnostic> CsvParser::begin_text(const char*& p) {
   if (std::string why; !options_.is_valid(&why)) return data_diag::invalid_csv_options(why);
   record_.path = path_;
   if (text_.empty()) return data_diag::empty_file(path_);
-  if (const void* nul = std::memchr(text_.data(), '\0', text_.size())) {
-    const char* at = static_cast<const char*>(nul);
-    const auto row = 1 + std::count(begin(), at, '\n');
-    const char* line_start = at;
-    while (line_start > begin() && *(line_start - 1) != '\n') --line_start;
-    return data_diag::binary_file(path_, static_cast<int>(row), static_cast<int>(at - line_start) + 1);
-  }
+  if (const auto nul = first_nul(begin(), begin(), end())) return data_diag::binary_file(path_, static_cast<int>(1 + nul->newlines), nul->column);
   p = begin();
   if (text_.size() >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;  // UTF-8 byte-order mark
 

@@ -49,6 +49,15 @@ struct Field {
 void append_later_rows(std::vector<std::vector<FaultyCell>>& faults, std::vector<std::pair<std::size_t, int>>& jumps, std::size_t rows,
                        int lines, std::vector<std::vector<FaultyCell>> later_faults, const std::vector<std::pair<std::size_t, int>>& later_jumps);
 
+// Where the first NUL byte in [first, last) is, if there is one (a binary file): the '\n' bytes
+// from `first` up to it, and its 1-based column, counted from the line start found by looking back
+// no further than `floor`.
+struct NulByte {
+  std::size_t newlines = 0;
+  int column = 0;
+};
+std::optional<NulByte> first_nul(const char* floor, const char* first, const char* last);
+
 class CsvParser {
  public:
   CsvParser(std::string_view text, const std::string& path, const CsvOptions& options)

@@ -18,6 +18,7 @@
 #include "runtime/solve/triangular_accumulator.hpp"
 
 #include "support/shell.hpp"
+#include "support/synthetic_record.hpp"
 #include "support/thread_share.hpp"
 #include "support/thesis_record.hpp"
 
@@ -183,15 +184,9 @@ TEST(RowShare, WeakFormRowsAreOneProcessesBitForBit) {
   const ir::Model m = testing::compiled_text("w.sid",
                                              "model weak_shared\ninput x\noutput y\nparam m, c, k\nset form = weak\n"
                                              "m*y'' + c*y' + k*y = x\n");
-  SampledRecord r;
-  r.path = "synthetic";
-  r.step = 0.001;
-  for (int i = 0; i < 100000; ++i) {
-    const double t = 0.001 * i;
-    r.time.push_back(t);
-    r.signals["x"].push_back(std::sin(1.3 * t) + 0.5 * std::sin(3.1 * t));
-    r.signals["y"].push_back(std::exp(-0.05 * t) * std::sin(2.0 * t) + 0.2 * std::sin(1.3 * t - 0.4) + 1e-4 * std::sin(977.0 * t));
-  }
+  const SampledRecord r = testing::synthetic_record(100000, 0.001, {
+      {"x", [](double t) { return std::sin(1.3 * t) + 0.5 * std::sin(3.1 * t); }},
+      {"y", [](double t) { return std::exp(-0.05 * t) * std::sin(2.0 * t) + 0.2 * std::sin(1.3 * t - 0.4) + 1e-4 * std::sin(977.0 * t); }}});
   FitOptions o;
   auto single = fit(m, {r}, o);
   ASSERT_TRUE(std::holds_alternative<FitSummary>(single)) << render(std::get<Diagnostic>(single));

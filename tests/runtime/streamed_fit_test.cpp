@@ -16,6 +16,7 @@
 #include "runtime/solve/fit.hpp"
 
 #include "support/shell.hpp"
+#include "support/synthetic_record.hpp"
 #include "support/thesis_record.hpp"
 
 namespace sidc {
@@ -179,16 +180,10 @@ TEST(StreamedFit, TwoGroupsAndInitialValues) {
   // Section 4-2's model (two equations sharing no parameter, y2(0) in the operations) on a
   // record made here: a damped response to a square-ish input.
   const ir::Model m = compiled_file(SIDC_SOURCE_DIR "/examples/thesis-4-2/process.sid");
-  SampledRecord r;
-  r.path = "synthetic";
-  r.step = 0.75;
-  for (int k = 0; k < 300; ++k) {
-    const double t = 0.75 * k;
-    r.time.push_back(t);
-    r.signals["x"].push_back(std::sin(0.05 * t) > 0 ? 1.0 : -0.5);
-    r.signals["y1"].push_back(std::exp(-0.01 * t) * std::sin(0.11 * t) + 0.01 * std::cos(1.3 * t));
-    r.signals["y2"].push_back(0.4 + std::cos(0.07 * t) - 0.02 * std::sin(2.1 * t));
-  }
+  const SampledRecord r = testing::synthetic_record(300, 0.75, {
+      {"x", [](double t) { return std::sin(0.05 * t) > 0 ? 1.0 : -0.5; }},
+      {"y1", [](double t) { return std::exp(-0.01 * t) * std::sin(0.11 * t) + 0.01 * std::cos(1.3 * t); }},
+      {"y2", [](double t) { return 0.4 + std::cos(0.07 * t) - 0.02 * std::sin(2.1 * t); }}});
   const FitSummary dense = fitted(m, {r}, {});
   ASSERT_EQ(dense.groups.size(), 2u);
   expect_same_fit(dense, fitted(m, {r}, streamed({}, 16)));
@@ -231,15 +226,9 @@ TEST(StreamedFit, ResidualsOfBlocksEvaluatedOnTheCoresMatchTheDenseOnes) {
   const ir::Model m = compiled_text("library.sid", "input x\noutput y\nparam m, c[1..6], s[1..6], d[1..7]\n"
                                                    "set derivative = savgol(7, 3)\n"
                                                    "m*y'' + sum(k = 1..6, c[k]*y'^k) + sum(k = 1..6, s[k]*y^k) + sum(k = 1..7, d[k]*y^k*y') = x\n");
-  SampledRecord r;
-  r.path = "synthetic";
-  r.step = 0.001;
-  for (int k = 0; k < 60000; ++k) {
-    const double t = 0.001 * k;
-    r.time.push_back(t);
-    r.signals["x"].push_back(std::sin(1.3 * t) + 0.4 * std::cos(3.7 * t));
-    r.signals["y"].push_back(0.8 * std::sin(1.1 * t + 0.2) + 0.3 * std::sin(2.9 * t) + 1e-4 * std::cos(41.0 * t));
-  }
+  const SampledRecord r = testing::synthetic_record(60000, 0.001, {
+      {"x", [](double t) { return std::sin(1.3 * t) + 0.4 * std::cos(3.7 * t); }},
+      {"y", [](double t) { return 0.8 * std::sin(1.1 * t + 0.2) + 0.3 * std::sin(2.9 * t) + 1e-4 * std::cos(41.0 * t); }}});
   FitOptions stream_options;
   stream_options.stream_above_entries = 0;
   stream_options.stream_block_rows = 2048;

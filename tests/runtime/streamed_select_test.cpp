@@ -17,6 +17,7 @@
 #include "runtime/select/size_rule.hpp"
 
 #include "support/shell.hpp"
+#include "support/synthetic_record.hpp"
 #include "support/thesis_record.hpp"
 
 namespace sidc {
@@ -99,16 +100,10 @@ TEST(StreamedSelect, TwoEquationsWeightsAndADriftAbsorber) {
                                     "input x\noutput y, z\nparam a, b, c, d, e\nset integrate = 1\nset weights = 1 + 0.5*x^2\n"
                                     "a*y' + b*y + d*cos(0.01*y) = x\n"
                                     "a*z' + c*z + e*z^3 = y\n");
-  SampledRecord r;
-  r.path = "synthetic";
-  r.step = 0.01;
-  for (int k = 0; k < 3000; ++k) {
-    const double t = 0.01 * k;
-    r.time.push_back(t);
-    r.signals["x"].push_back(std::sin(0.7 * t) + 0.3 * std::cos(2.3 * t));
-    r.signals["y"].push_back(std::sin(0.5 * t + 0.2) + 0.01 * std::sin(17.0 * t));
-    r.signals["z"].push_back(std::cos(0.4 * t) + 0.02 * std::cos(11.0 * t));
-  }
+  const SampledRecord r = testing::synthetic_record(3000, 0.01, {
+      {"x", [](double t) { return std::sin(0.7 * t) + 0.3 * std::cos(2.3 * t); }},
+      {"y", [](double t) { return std::sin(0.5 * t + 0.2) + 0.01 * std::sin(17.0 * t); }},
+      {"z", [](double t) { return std::cos(0.4 * t) + 0.02 * std::cos(11.0 * t); }}});
   const SelectSummary whole = selected(m, {r}, whole_rows());
   ASSERT_EQ(whole.groups.size(), 1u);
   ASSERT_EQ(whole.groups[0].equations.size(), 2u);

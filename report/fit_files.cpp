@@ -292,11 +292,20 @@ nlohmann::ordered_json validation_json(const FitValidation& v, std::size_t fitte
       return o;
     };
     const bool estimated = run.initial_method == InitialState::estimate && run.start_segment > 0;
+    ordered_json restarted = nullptr;  // validate.hpp, kRestartPeriods: the sensitivity test, when made
+    if (const auto& r = run.restarted) {
+      ordered_json fits = ordered_json::array();
+      for (const auto& [output, fit] : r->fit_percent) fits.push_back({{"output", output}, {"fit_percent", fit}});
+      restarted = {{"free_run_departs_at", r->free_run_departs_at}, {"separates_at", r->separates_at}, {"sensitive", r->sensitive},
+                   {"fastest_period", r->period}, {"judged", r->judged},
+                   {"runs", r->runs}, {"run_duration", r->judged ? ordered_json(r->run_duration) : ordered_json(nullptr)},
+                   {"completed", r->completed}, {"follows", r->follows}, {"outputs", fits}};
+    }
     runs.push_back({{"record", run.record}, {"held_out", i >= fitted_records}, {"completed", run.simulation.completed()},
                     {"stopped_at", optional(run.simulation.stopped_at)},
                     {"statement", run.statement},
                     {"verdict", {{"follows", run.follows}, {"threshold_fit_percent", kFollowsFitPercent}, {"departure_share", kDepartureShare},
-                                 {"outputs", verdict}}},
+                                 {"outputs", verdict}, {"restarted", restarted}}},
                     {"initial_state", state(run.initial_state)}, {"initial_state_method", estimated ? "estimate" : "record"},
                     {"initial_state_from_record", state(run.recorded_state)},
                     {"start_segment_samples", estimated ? ordered_json(run.start_segment) : ordered_json(nullptr)},

@@ -306,7 +306,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
     // Segment k covers grid samples [bound(k), bound(k + 1)], the intervals shared out evenly.
     const auto bound = [&](std::size_t k) { return k * (total - 1) / pieces; };
     if (pieces > 1 && options.substeps == 0)  // the steps from the first segment's run
-      chosen = substeps_for(normalized, form, RecordRun{run.options.samples(0, bound(1) + 1), {}, run.start, false}, tolerance);
+      chosen = substeps_for(normalized, form, RecordRun{run.options.samples(0, bound(1) + 1), {}, run.start, false, {}}, tolerance);
     if (options.substeps > 0) run.options.substeps = options.substeps;
     else if (chosen) run.options.substeps = *chosen;
     summary.substeps.push_back(run.options.substeps);
@@ -319,7 +319,7 @@ std::variant<RefineSummary, Diagnostic> refine(const ir::Model& normalized, cons
     for (std::size_t k = 0; k < pieces; ++k) {
       const std::size_t a = bound(k), b = bound(k + 1) + 1;  // [a, b), sharing b - 1 with the next (bound(pieces) = total - 1)
       const bool last = k + 1 == pieces;
-      RecordRun piece{run.options.samples(a, b), {}, run.start + a, false};
+      RecordRun piece{run.options.samples(a, b), {}, run.start + a, false, {}};
       for (const auto& column : run.recorded)
         piece.recorded.emplace_back(column.begin() + static_cast<std::ptrdiff_t>(a), column.begin() + static_cast<std::ptrdiff_t>(b));
       if (k > 0) {

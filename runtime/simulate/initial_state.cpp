@@ -92,6 +92,7 @@ InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const E
   const auto n = static_cast<Eigen::Index>(problem.size());
   Eigen::MatrixXd J(r.size(), n);
   double lambda = 1e-3;
+  bool jacobian_at_hand = false;
   for (int iteration = 0; iteration < kMaxIterations && cost > 0; ++iteration) {
     // Forward differences: RK4 on a fixed grid is a smooth function of the start (linear for a
     // linear model), so a relative step of 1e-7 loses only the digits that step costs.
@@ -109,6 +110,7 @@ InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const E
     }
     if (!sensitivities) break;
     const Eigen::MatrixXd normal = J.transpose() * J;
+    jacobian_at_hand = true;
     const Eigen::VectorXd gradient = J.transpose() * r;
     const double largest = normal.diagonal().maxCoeff();
     if (!(largest > 0)) break;  // the segment does not depend on the start
@@ -136,6 +138,26 @@ InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const E
   }
   out.initial = problem.map_of(x);
   out.cost_after = cost;
+  // The uncertainty's axes from the last Jacobian (taken at the iterate before the last step, which
+  // the convergence test makes a negligible difference).
+  const auto rows = static_cast<Eigen::Index>(problem.rows());
+  if (jacobian_at_hand && rows > n) {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+    const double sigma = std::sqrt(cost / static_cast<double>(rows - n));
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const double s = svd.singularValues()(k);
+      if (!(s > 0)) {
+        out.uncertainty_axes.clear();
+        break;
+      }
+      const Eigen::VectorXd axis = (sigma / s) * svd.matrixV().col(k);
+      if (!axis.allFinite()) {
+        out.uncertainty_axes.clear();
+        break;
+      }
+      out.uncertainty_axes.emplace_back(axis.data(), axis.data() + axis.size());
+    }
+  }
   return out;
 }
 

@@ -11,7 +11,14 @@
 // is output j's standard deviation over the segment (1 when it is constant), so outputs of
 // different size weigh alike. A trial start whose run diverges or becomes singular counts as
 // infinitely bad, so the result never reproduces the segment worse than the starting guess.
-// Deterministic; at most kMaxIterations iterations.
+// Deterministic; at most kMaxIterations iterations. How far the start is known comes from the last
+// Jacobian J: Gauss-Newton's covariance sigma^2 (J^T J)^-1 (sigma^2 the segment's mean square
+// residual), given by the axes of its one-standard-deviation ellipsoid, sigma v_k / s_k for J's
+// singular values s_k and right singular vectors v_k: each a displacement of the start that fits
+// the segment worse by one sigma. Axes, not per-component standard errors: on a chaotic record the
+// start is known to a hair along the directions the solution amplifies and loosely along those it
+// damps, and the components' errors mix the two (validation's sensitivity test displaces the start
+// along each axis).
 #pragma once
 
 #include <map>
@@ -28,6 +35,9 @@ struct InitialStateEstimate {
   std::size_t segment = 0;                              // samples compared
   int iterations = 0;                                   // accepted Levenberg-Marquardt steps
   double cost_before = 0, cost_after = 0;               // the sum of squares above, at the guess and at the estimate
+  // The uncertainty ellipsoid's axes, each a displacement of the state (the explicit form's
+  // order); empty when no Jacobian was formed or one direction leaves the segment unchanged.
+  std::vector<std::vector<double>> uncertainty_axes;
 };
 
 // `options`: the whole run (grid, inputs, parameters, initial guess in `initial`); `recorded`:

@@ -55,6 +55,140 @@ std::optional<double> departure(std::span<const double> y, std::span<const doubl
   return std::nullopt;
 }
 
+// A sum of squares kept as scale^2 * sum (LAPACK's dnrm2 way): finite for values near 1e200.
+struct ScaledSquares {
+  double scale = 0, sum = 0;
+  void add(double x) {
+    const double a = std::abs(x);
+    if (a == 0) return;
+    if (a > scale) {
+      sum = 1 + sum * (scale / a) * (scale / a);
+      scale = a;
+    } else {
+      sum += (a / scale) * (a / scale);
+    }
+  }
+  double norm() const { return scale * std::sqrt(sum); }
+};
+
+// The period of the output that varies fastest: for each, twice its mean time between passes
+// from below its mean to above it or back, by a quarter of its standard deviation either side (so
+// noise about the mean makes no passes); the record's duration for an output that never passes.
+double fastest_period(const std::vector<Column>& recorded, std::span<const double> time) {
+  const double duration = time.back() - time.front();
+  double fastest = duration;
+  for (const Column& y : recorded) {
+    double mean = 0;
+    std::size_t n = 0;
+    for (double v : y) if (std::isfinite(v)) mean += v, ++n;
+    if (n < 2) continue;
+    mean /= static_cast<double>(n);
+    double squares = 0;
+    for (double v : y) if (std::isfinite(v)) squares += (v - mean) * (v - mean);
+    const double band = 0.25 * std::sqrt(squares / static_cast<double>(n));
+    int side = 0;
+    std::size_t passes = 0;
+    for (double v : y) {
+      const int now = v > mean + band ? 1 : v < mean - band ? -1 : 0;
+      if (now != 0 && side != 0 && now != side) ++passes;
+      if (now != 0) side = now;
+    }
+    if (passes > 0) fastest = std::min(fastest, 2 * duration / static_cast<double>(passes));
+  }
+  return fastest;
+}
+
+// The sensitivity test and the restarted runs of ValidationSummary::Restarted, for a completed
+// free run `v` of `prepared` (its options with the estimated start, the free-run method) that
+// departs at `departs_at`. nullopt when the test cannot be made (no uncertainty axes, a failed run).
+std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Model& normalized, const ExplicitForm& form,
+                                                                   const SampledRecord& record, const RecordRun& prepared,
+                                                                   const SimulateOptions& free_run, const ValidationSummary& v,
+                                                                   const std::vector<std::vector<double>>& axes, double departs_at,
+                                                                   const ValidationOptions& options) {
+  const std::span<const double> time = free_run.time;
+  const std::size_t n = time.size();
+  if (axes.size() != form.state_size() || n < 2 * kShortestRestart) return std::nullopt;
+  ValidationSummary::Restarted out;
+  out.start = time.front();
+  out.free_run_departs_at = departs_at;
+  // The free run again from a start displaced along each axis of the estimate's uncertainty.
+  double separates = INFINITY;
+  const std::vector<double> start = state_vector(form, free_run.initial);
+  for (const auto& axis : axes) {
+    SimulateOptions displaced = free_run;
+    displaced.progress = {};
+    std::vector<double> x = start;
+    for (std::size_t k = 0; k < x.size(); ++k) x[k] += axis[k];
+    displaced.initial = state_map(form, x);
+    auto twin = simulate(normalized, form, displaced);
+    if (!std::holds_alternative<SimulationSummary>(twin)) return std::nullopt;
+    const SimulationSummary& other = std::get<SimulationSummary>(twin);
+    if (!other.completed()) separates = std::min(separates, other.stopped_at.value_or(time.front()));
+    for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+      const OutputValidation& r = v.outputs[j];
+      if (!(r.spread > 0)) continue;
+      if (auto t = departure(v.simulation.outputs[j], other.outputs[j], time, kDepartureShare * r.spread)) separates = std::min(separates, *t);
+    }
+  }
+  if (!std::isfinite(separates)) return out;  // the displacement stays small: a stable run, judged by itself
+  out.separates_at = separates;
+  out.sensitive = separates - time.front() <= 2 * (departs_at - time.front());
+  out.period = fastest_period(v.recorded, time);
+  if (!out.sensitive) return out;
+
+  // Runs of half the horizon, restarted from the record's state (moving arc, then estimated).
+  const std::size_t horizon = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), separates) - time.begin());
+  const std::size_t length = horizon / 2;
+  if (length < kShortestRestart || length >= n || time[length] - time.front() < kRestartPeriods * out.period) return out;
+  out.judged = true;
+  out.run_duration = time[length] - time.front();
+  std::vector<ScaledSquares> errors(form.outputs.size()), deviations(form.outputs.size());
+  std::vector<double> means(form.outputs.size(), 0.0);
+  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+    std::size_t count = 0;
+    for (double y : v.recorded[j]) if (std::isfinite(y)) means[j] += y, ++count;
+    if (count) means[j] /= static_cast<double>(count);
+  }
+  for (std::size_t first = 0; first < n;) {
+    // The last run takes what is left when less than half a run would remain.
+    const std::size_t last = first + length + length / 2 > n ? n : first + length;
+    auto guess = initial_state_from_record(form, record, prepared.state_evaluation, prepared.start + first, true);
+    if (!std::holds_alternative<std::map<std::string, std::vector<double>>>(guess)) return std::nullopt;
+    SimulateOptions run = free_run.samples(first, last);
+    run.progress = {};
+    run.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(guess));
+    std::vector<Column> recorded;
+    for (const Column& y : v.recorded)  // views of v.recorded, which outlives them (a handle that owns nothing)
+      recorded.push_back(Column::borrowed(std::span<const double>(y).subspan(first, last - first),
+                                          std::shared_ptr<const void>(std::shared_ptr<const void>{}, &v)));
+    SimulateOptions estimate_with = run;
+    estimate_with.method = options.method;  // as validate() estimates the free run's start
+    run.initial = estimate_initial_state(normalized, form, estimate_with, recorded, start_segment_samples(last - first)).initial;
+    auto solved = simulate(normalized, form, run);
+    if (!std::holds_alternative<SimulationSummary>(solved)) return std::nullopt;
+    const SimulationSummary& s = std::get<SimulationSummary>(solved);
+    out.completed = out.completed && s.completed();
+    for (std::size_t j = 0; j < form.outputs.size(); ++j)
+      for (std::size_t i = 0; i < last - first; ++i) {
+        const double y = recorded[j][i], e = y - s.outputs[j][i];
+        if (!std::isfinite(y)) continue;
+        deviations[j].add(y - means[j]);
+        if (std::isfinite(e)) errors[j].add(e);
+      }
+    ++out.runs;
+    first = last;
+  }
+  out.follows = out.completed;
+  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+    const double d = deviations[j].norm();
+    const double fit = d > 0 ? 100 * (1 - errors[j].norm() / d) : (errors[j].norm() == 0 ? 100 : NAN);
+    out.fit_percent.emplace_back(form.outputs[j].name, fit);
+    out.follows = out.follows && fit >= kFollowsFitPercent;
+  }
+  return out;
+}
+
 }  // namespace
 
 SimulateOptions::Method free_run_method(const ir::Model& normalized, const ExplicitForm& form) {
@@ -124,6 +258,7 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   auto initial = initial_state_from_record(form, record, std::get<EvaluationOptions>(chosen), start, true);
   if (auto* d = std::get_if<Diagnostic>(&initial)) return *d;
   o.initial = std::get<std::map<std::string, std::vector<double>>>(std::move(initial));
+  run.state_evaluation = std::get<EvaluationOptions>(chosen);
   run.start = start;
   run.truncated = static_cast<std::size_t>(to) < record.time.size();
   for (const auto& out : form.outputs) run.recorded.push_back(on_grid(record.signals.at(out.name)));
@@ -143,10 +278,12 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   v.truncated = prepared_run.truncated;
   v.recorded_state = named_state(form, o.initial);
   v.initial_method = options.initial_state;
+  std::vector<std::vector<double>> start_axes;  // the estimated start's uncertainty (sensitivity test)
   if (options.initial_state == InitialState::estimate && o.time.size() >= 2) {
     // With options.method (RK4 by default); ValidationOptions::choose_method changes only the free run below.
     const InitialStateEstimate estimate = estimate_initial_state(normalized, form, o, recorded, start_segment_samples(o.time.size()));
     o.initial = estimate.initial;
+    start_axes = estimate.uncertainty_axes;
     v.start_segment = estimate.segment;
     v.estimate_iterations = estimate.iterations;
   }
@@ -194,13 +331,20 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
                                                                       : NAN;
     r.rms_error = r.samples ? scale * std::sqrt(sum_e2 / static_cast<double>(r.samples)) : NAN;
     r.follows = v.simulation.completed() && r.fit_percent >= kFollowsFitPercent;
-    const double spread = r.samples ? scale * std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;
-    r.departs_at = departure(y, yhat, o.time, kDepartureShare * spread);
+    r.spread = r.samples ? scale * std::sqrt(sum_d2 / static_cast<double>(r.samples)) : 0.0;
+    r.departs_at = departure(y, yhat, o.time, kDepartureShare * r.spread);
     if (!r.departs_at && !v.simulation.completed()) r.departs_at = v.simulation.stopped_at;
     v.outputs.push_back(r);
     v.recorded.push_back(std::move(prepared_run.recorded[j]));  // not read again
   }
   v.follows = v.simulation.completed() && std::all_of(v.outputs.begin(), v.outputs.end(), [](const OutputValidation& r) { return r.follows; });
+  if (options.check_sensitivity && v.simulation.completed() && !v.follows) {
+    std::optional<double> departs;
+    for (const auto& r : v.outputs)
+      if (!r.follows && r.departs_at && (!departs || *r.departs_at < *departs)) departs = r.departs_at;
+    if (departs) v.restarted = restart_within_horizon(normalized, form, record, prepared_run, o, v, start_axes, *departs, options);
+    if (v.restarted && v.restarted->judged) v.follows = v.restarted->follows;
+  }
   if (v.simulation.completed()) {
     // The sentence follows from the numbers: "follow it" only when every output's fit % reaches
     // kFollowsFitPercent; otherwise it names each output that falls short, where it departs and
@@ -220,12 +364,39 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     }
     v.statement = short_of.empty() ? "The fitted equations, solved from the record, follow it: " + parts + "."
                                    : "The fitted equations, solved from the record, do not follow it: " + short_of + ".";
+    if (v.restarted && v.restarted->sensitive) v.statement = v.restarted->statement(short_of);
   } else {
     v.statement = fmt::format("The fitted equations could not be solved over the whole record: {}. The model does not reproduce the record; "
                               "the numbers below cover the samples before t = {:.6g}.",
                               v.simulation.message, v.simulation.stopped_at.value_or(record.time.front()));
   }
   return v;
+}
+
+std::string ValidationSummary::Restarted::statement(const std::string& free_run) const {
+  std::string fits;
+  for (const auto& [output, fit] : fit_percent)
+    fits += fmt::format("{}fit {:.4g}% for {}{}", fits.empty() ? "" : ", ", fit, output, fit >= kFollowsFitPercent ? "" : fmt::format(" (below {:g}%)", kFollowsFitPercent));
+  const std::string twin =
+      separates_at <= start
+          ? "the initial state estimated over the start segment is itself uncertain by more than a tenth of an output's spread"
+          : fmt::format("started one standard deviation of the estimated initial state away, their own solution separates from this one by t = {:.4g}",
+                        separates_at);
+  if (!judged)
+    return fmt::format("The fitted equations, solved from the record, do not follow it: {}. But they are as sensitive to their initial state ({}), "
+                       "so the departure may be that sensitivity rather than the model; runs restarted from the record within that horizon "
+                       "would be shorter than {:g} periods of the output that varies fastest ({:.4g}), too short to judge the model by.",
+                       free_run, twin, kRestartPeriods, period);
+  const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs, each from a state estimated over its start)",
+                                            run_duration, runs);
+  if (follows)
+    return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "
+                       "they depart at t = {:.4g}, as they must: {}, so no run from a state known only to within the record's noise can follow "
+                       "it for longer (a chaotic or unstable solution). The free run: {}.",
+                       runs_text, fits, free_run_departs_at, twin, free_run);
+  return fmt::format("The fitted equations, solved from the record, do not follow it: {}. Nor when {}, within the horizon their own "
+                     "sensitivity to the initial state allows ({}): {}{}.",
+                     free_run, runs_text, twin, fits, completed ? "" : "; a restarted run could not be solved to its end");
 }
 
 std::string ValidationSummary::report(const std::string& method) const {
@@ -275,6 +446,7 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   o.max_samples = max_samples;
   o.initial_state = initial_state;
   o.progress = progress;
+  o.check_sensitivity = true;
   for (std::size_t r = 0; r < records.size(); ++r) {
     auto run = validate(normalized, std::get<ExplicitForm>(form), parameters, *records[r], o);
     if (auto* d = std::get_if<Diagnostic>(&run)) {

@@ -80,7 +80,26 @@ struct ValidationOptions {
   bool from_first_sample = false;
   // Optional: the free run's progress (SimulateOptions::progress), with the record's path.
   std::function<void(const std::string& record, std::size_t done, std::size_t total)> progress;
+  // When the free run departs: test whether the equations are that sensitive to their initial
+  // state, and if so judge them by runs restarted from the record within their horizon
+  // (ValidationSummary::Restarted). sidc fit's validation; not the form choice or select, which
+  // compare candidates by the free run alone.
+  bool check_sensitivity = false;
 };
+
+// A chaotic or unstable system's solution cannot follow a record for long from any initial state
+// known only to within its noise: two solutions started within that uncertainty separate as fast.
+// So when the free run departs, it is run again from the estimated initial state displaced along
+// each axis of its one-standard-deviation ellipsoid (InitialStateEstimate::uncertainty_axes); if a
+// displaced run separates from the free run (by the departure test) no later than twice the time
+// the record took to depart, the departure is what the equations' own sensitivity explains, and
+// the verdict is taken instead from runs restarted from the record every half of that horizon
+// (each from a state estimated over its own start segment), provided they span at least
+// kRestartPeriods periods of the output that varies fastest: shorter runs would let a wrong model
+// pass. A stable system contracts the displacement, so a model that departs there is judged by the
+// free run as before.
+inline constexpr double kRestartPeriods = 2;
+inline constexpr std::size_t kShortestRestart = 20;  // samples in each restarted run, at least
 
 // The solver of a validation's free run: the adaptive stepper (Odeint's dopri5 with dense output
 // at the samples, tolerance 1e-9), whose steps span as many sample intervals as the solution
@@ -102,6 +121,7 @@ struct OutputValidation {
   double percent_error = 0;       // eq. 4-1.5
   double fit_percent = 0;         // 100 (1 - ||y - yhat|| / ||y - mean(y)||)
   double rms_error = 0;
+  double spread = 0;              // the recorded output's standard deviation about its mean (samples compared)
   bool follows = false;               // fit % >= kFollowsFitPercent and the run completed
   std::optional<double> departs_at;   // see kDepartureShare; the stop when it stopped first; none when it never departs
 };
@@ -119,6 +139,23 @@ struct ValidationSummary {
   // Per output, on simulation.time: the record (the solution is simulation.outputs, the error
   // E = recorded - simulated, eq. 4-1.4, not held: 8 bytes a sample less).
   std::vector<Column> recorded;  // borrowed from the record
+  // The sensitivity test and the restarted runs (see kRestartPeriods): set when it was made.
+  struct Restarted {
+    double start = 0;                // t of the free run's first sample
+    double free_run_departs_at = 0;  // the first departure of an output that does not follow
+    double separates_at = 0;         // where the first displaced run departs from the free run
+    bool sensitive = false;          // separates_at - t0 <= 2 (free_run_departs_at - t0)
+    double period = 0;               // of the fastest output (twice its mean time between mean crossings)
+    bool judged = false;             // sensitive, and the restarted runs long enough to judge by
+    std::size_t runs = 0;
+    double run_duration = 0;         // of each run but perhaps the last (time units)
+    std::vector<std::pair<std::string, double>> fit_percent;  // per output, over every restarted run
+    bool completed = true;           // every restarted run reached its end
+    bool follows = false;            // judged, completed and every output at kFollowsFitPercent or more
+    // The verdict's sentence, given the free run's shortfall as validate() words it.
+    std::string statement(const std::string& free_run) const;
+  };
+  std::optional<Restarted> restarted;
   std::string statement;  // one plain sentence: how well, or where it diverged
   bool truncated = false;  // ValidationOptions::max_samples stopped it before the record's end
   std::string report(const std::string& method) const;
@@ -136,6 +173,7 @@ struct RecordRun {
   std::vector<Column> recorded;               // per output of the form, on options.time (borrowed from the record)
   std::size_t start = 0;                      // the record's sample at options.time[0]
   bool truncated = false;                     // max_samples stopped the grid before the record's end
+  EvaluationOptions state_evaluation;         // the moving arcs of the initial state (at any sample)
 };
 // `record` must outlive the result (options.initial_value reads it).
 std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, const ExplicitForm& form, const std::vector<double>& parameters,

@@ -296,9 +296,11 @@ nlohmann::ordered_json validation_json(const FitValidation& v, std::size_t fitte
     if (const auto& r = run.restarted) {
       ordered_json fits = ordered_json::array();
       for (const auto& [output, fit] : r->fit_percent) fits.push_back({{"output", output}, {"fit_percent", fit}});
-      restarted = {{"free_run_departs_at", r->free_run_departs_at}, {"separates_at", r->separates_at}, {"sensitive", r->sensitive},
+      restarted = {{"free_run_departs_at", r->free_run_departs_at}, {"separates_at", r->separates_at},
+                   {"start_unfitted", r->start_unfitted}, {"sensitive", r->sensitive},
                    {"fastest_period", r->period}, {"judged", r->judged},
-                   {"runs", r->runs}, {"run_duration", r->judged ? ordered_json(r->run_duration) : ordered_json(nullptr)},
+                   {"runs", r->runs}, {"run_duration", r->runs ? ordered_json(r->run_duration) : ordered_json(nullptr)},
+                   {"compared_share", r->runs ? ordered_json(r->compared_share) : ordered_json(nullptr)},
                    {"completed", r->completed}, {"follows", r->follows}, {"outputs", fits}};
     }
     runs.push_back({{"record", run.record}, {"held_out", i >= fitted_records}, {"completed", run.simulation.completed()},

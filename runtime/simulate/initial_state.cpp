@@ -35,6 +35,7 @@ class StartProblem {
   std::size_t size() const { return form_.state_size(); }
   std::size_t rows() const { return segment_ * form_.outputs.size(); }
   double typical(std::size_t k) const { return typical_[k]; }
+  const std::vector<double>& scales() const { return scale_; }
 
   Eigen::VectorXd vector_of(const std::map<std::string, std::vector<double>>& initial) const {
     const std::vector<double> x = state_vector(form_, initial);
@@ -143,14 +144,15 @@ InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const E
   const auto rows = static_cast<Eigen::Index>(problem.rows());
   if (jacobian_at_hand && rows > n) {
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
-    const double sigma = std::sqrt(cost / static_cast<double>(rows - n));
+    out.residual_sd = std::sqrt(cost / static_cast<double>(rows - n));
+    out.scales = problem.scales();
     for (Eigen::Index k = 0; k < n; ++k) {
       const double s = svd.singularValues()(k);
       if (!(s > 0)) {
         out.uncertainty_axes.clear();
         break;
       }
-      const Eigen::VectorXd axis = (sigma / s) * svd.matrixV().col(k);
+      const Eigen::VectorXd axis = svd.matrixV().col(k) / s;
       if (!axis.allFinite()) {
         out.uncertainty_axes.clear();
         break;

@@ -12,13 +12,14 @@
 // different size weigh alike. A trial start whose run diverges or becomes singular counts as
 // infinitely bad, so the result never reproduces the segment worse than the starting guess.
 // Deterministic; at most kMaxIterations iterations. How far the start is known comes from the last
-// Jacobian J: Gauss-Newton's covariance sigma^2 (J^T J)^-1 (sigma^2 the segment's mean square
-// residual), given by the axes of its one-standard-deviation ellipsoid, sigma v_k / s_k for J's
-// singular values s_k and right singular vectors v_k: each a displacement of the start that fits
-// the segment worse by one sigma. Axes, not per-component standard errors: on a chaotic record the
-// start is known to a hair along the directions the solution amplifies and loosely along those it
-// damps, and the components' errors mix the two (validation's sensitivity test displaces the start
-// along each axis).
+// Jacobian J: Gauss-Newton's covariance sigma^2 (J^T J)^-1 for residuals of standard deviation
+// sigma (in units of s_j), given by the axes of its ellipsoid, sigma v_k / s_k for J's singular
+// values s_k and right singular vectors v_k: each a displacement of the start that fits the
+// segment worse by sigma. Axes, not per-component standard errors: on a chaotic record the start is
+// known to a hair along the directions the solution amplifies and loosely along those it damps,
+// and the components' errors mix the two (validation's sensitivity test displaces the start along
+// each axis, with sigma the record's noise level rather than the misfit, so that a wrong model
+// does not widen its own uncertainty).
 #pragma once
 
 #include <map>
@@ -35,9 +36,11 @@ struct InitialStateEstimate {
   std::size_t segment = 0;                              // samples compared
   int iterations = 0;                                   // accepted Levenberg-Marquardt steps
   double cost_before = 0, cost_after = 0;               // the sum of squares above, at the guess and at the estimate
-  // The uncertainty ellipsoid's axes, each a displacement of the state (the explicit form's
-  // order); empty when no Jacobian was formed or one direction leaves the segment unchanged.
+  // The uncertainty ellipsoid's axes for sigma = 1, each a displacement of the state (the explicit
+  // form's order); empty when no Jacobian was formed or one direction leaves the segment unchanged.
   std::vector<std::vector<double>> uncertainty_axes;
+  std::vector<double> scales;  // s_j, per output
+  double residual_sd = 0;      // the misfit's sigma, sqrt(cost / (rows - state size)), in units of s_j
 };
 
 // `options`: the whole run (grid, inputs, parameters, initial guess in `initial`); `recorded`:

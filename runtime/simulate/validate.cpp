@@ -1,5 +1,7 @@
 #include "runtime/simulate/validate.hpp"
 
+#include "runtime/operators/noise_level.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,6 +9,7 @@
 #include <memory>
 #include <fmt/format.h>
 
+#include "runtime/operators/noise_level.hpp"
 #include "runtime/simulate/initial_state.hpp"
 #include "runtime/solve/fitted_values.hpp"
 
@@ -71,31 +74,76 @@ struct ScaledSquares {
   double norm() const { return scale * std::sqrt(sum); }
 };
 
-// The period of the output that varies fastest: for each, twice its mean time between passes
-// from below its mean to above it or back, by a quarter of its standard deviation either side (so
-// noise about the mean makes no passes); the record's duration for an output that never passes.
+// The period of the output that varies fastest: for each, twice the record's duration over the
+// number of its turning points, counted as a zig-zag does (a maximum or minimum counts once the
+// output has moved away from it by `band`: a quarter of its standard deviation, and at least five
+// times its noise level, so noise makes no turns). Turning points rather than crossings of the
+// mean: an output that oscillates within one well of a double well (a chaotic Duffing
+// oscillator) crosses its mean only when it changes wells. The record's duration for an output
+// that never turns.
 double fastest_period(const std::vector<Column>& recorded, std::span<const double> time) {
   const double duration = time.back() - time.front();
   double fastest = duration;
   for (const Column& y : recorded) {
-    double mean = 0;
-    std::size_t n = 0;
-    for (double v : y) if (std::isfinite(v)) mean += v, ++n;
-    if (n < 2) continue;
-    mean /= static_cast<double>(n);
-    double squares = 0;
-    for (double v : y) if (std::isfinite(v)) squares += (v - mean) * (v - mean);
-    const double band = 0.25 * std::sqrt(squares / static_cast<double>(n));
-    int side = 0;
-    std::size_t passes = 0;
+    const double band = std::max(0.25 * standard_deviation(y), 5 * estimate_noise_level(y).sigma);
+    if (!(band > 0) || !std::isfinite(band)) continue;
+    int direction = 0;  // +1 rising from the last turn, -1 falling; 0 before the first swing
+    double extreme = NAN, high = -INFINITY, low = INFINITY;
+    std::size_t turns = 0;
     for (double v : y) {
-      const int now = v > mean + band ? 1 : v < mean - band ? -1 : 0;
-      if (now != 0 && side != 0 && now != side) ++passes;
-      if (now != 0) side = now;
+      if (!std::isfinite(v)) continue;
+      if (direction == 0) {
+        high = std::max(high, v), low = std::min(low, v);
+        if (v < high - band) direction = -1, extreme = v;
+        else if (v > low + band) direction = 1, extreme = v;
+      } else if (direction * (v - extreme) > 0) {
+        extreme = v;
+      } else if (direction * (extreme - v) > band) {
+        ++turns, direction = -direction, extreme = v;
+      }
     }
-    if (passes > 0) fastest = std::min(fastest, 2 * duration / static_cast<double>(passes));
+    if (turns > 0) fastest = std::min(fastest, 2 * duration / static_cast<double>(turns));
   }
   return fastest;
+}
+
+// The axes of `estimate`'s uncertainty for residuals of the record's noise level (`noise`, per
+// output) rather than the misfit's, at least `floor` of each output's spread (the solver's
+// tolerance, for a record without noise); empty when the estimate has none.
+std::vector<std::vector<double>> uncertainty_axes(const InitialStateEstimate& estimate, const std::vector<double>& noise, double floor) {
+  if (estimate.scales.size() != noise.size() || noise.empty()) return {};
+  double squares = 0;
+  for (std::size_t j = 0; j < noise.size(); ++j) squares += (noise[j] / estimate.scales[j]) * (noise[j] / estimate.scales[j]);
+  const double sigma = std::max(std::sqrt(squares / static_cast<double>(noise.size())), floor);
+  std::vector<std::vector<double>> axes = estimate.uncertainty_axes;
+  for (auto& axis : axes)
+    for (double& x : axis) x *= sigma;
+  return axes;
+}
+
+// Where runs from `run`'s start displaced along each of `axes` first separate from `nominal` (its
+// solution): the departure test with kDepartureShare of each output's `spreads`, or where a
+// displaced run stops; infinity when none separates, nullopt when one cannot be run.
+std::optional<double> separation(const ir::Model& normalized, const ExplicitForm& form, const SimulateOptions& run,
+                                 const SimulationSummary& nominal, const std::vector<std::vector<double>>& axes,
+                                 const std::vector<double>& spreads) {
+  double separates = INFINITY;
+  const std::vector<double> start = state_vector(form, run.initial);
+  for (const auto& axis : axes) {
+    SimulateOptions displaced = run;
+    displaced.progress = {};
+    std::vector<double> x = start;
+    for (std::size_t k = 0; k < x.size(); ++k) x[k] += axis[k];
+    displaced.initial = state_map(form, x);
+    auto twin = simulate(normalized, form, displaced);
+    if (!std::holds_alternative<SimulationSummary>(twin)) return std::nullopt;
+    const SimulationSummary& other = std::get<SimulationSummary>(twin);
+    if (!other.completed()) separates = std::min(separates, other.stopped_at.value_or(run.time.front()));
+    for (std::size_t j = 0; j < form.outputs.size(); ++j)
+      if (spreads[j] > 0)
+        if (auto t = departure(nominal.outputs[j], other.outputs[j], run.time, kDepartureShare * spreads[j])) separates = std::min(separates, *t);
+  }
+  return separates;
 }
 
 // The sensitivity test and the restarted runs of ValidationSummary::Restarted, for a completed
@@ -104,44 +152,34 @@ double fastest_period(const std::vector<Column>& recorded, std::span<const doubl
 std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Model& normalized, const ExplicitForm& form,
                                                                    const SampledRecord& record, const RecordRun& prepared,
                                                                    const SimulateOptions& free_run, const ValidationSummary& v,
-                                                                   const std::vector<std::vector<double>>& axes, double departs_at,
-                                                                   const ValidationOptions& options) {
+                                                                   const std::vector<std::vector<double>>& axes, const std::vector<double>& noise,
+                                                                   double departs_at, const ValidationOptions& options) {
   const std::span<const double> time = free_run.time;
   const std::size_t n = time.size();
   if (axes.size() != form.state_size() || n < 2 * kShortestRestart) return std::nullopt;
   ValidationSummary::Restarted out;
   out.start = time.front();
   out.free_run_departs_at = departs_at;
-  // The free run again from a start displaced along each axis of the estimate's uncertainty.
-  double separates = INFINITY;
-  const std::vector<double> start = state_vector(form, free_run.initial);
-  for (const auto& axis : axes) {
-    SimulateOptions displaced = free_run;
-    displaced.progress = {};
-    std::vector<double> x = start;
-    for (std::size_t k = 0; k < x.size(); ++k) x[k] += axis[k];
-    displaced.initial = state_map(form, x);
-    auto twin = simulate(normalized, form, displaced);
-    if (!std::holds_alternative<SimulationSummary>(twin)) return std::nullopt;
-    const SimulationSummary& other = std::get<SimulationSummary>(twin);
-    if (!other.completed()) separates = std::min(separates, other.stopped_at.value_or(time.front()));
-    for (std::size_t j = 0; j < form.outputs.size(); ++j) {
-      const OutputValidation& r = v.outputs[j];
-      if (!(r.spread > 0)) continue;
-      if (auto t = departure(v.simulation.outputs[j], other.outputs[j], time, kDepartureShare * r.spread)) separates = std::min(separates, *t);
-    }
-  }
-  if (!std::isfinite(separates)) return out;  // the displacement stays small: a stable run, judged by itself
-  out.separates_at = separates;
-  out.sensitive = separates - time.front() <= 2 * (departs_at - time.front());
+  std::vector<double> spreads;
+  for (const auto& r : v.outputs) spreads.push_back(r.spread);
+  const std::optional<double> separates = separation(normalized, form, free_run, v.simulation, axes, spreads);
+  if (!separates) return std::nullopt;
+  if (!std::isfinite(*separates)) return out;  // the displacement stays small: a stable run, judged by itself
+  out.separates_at = *separates;
+  // A free run that departs within the segment its start was estimated over has a start that did
+  // not fit even there (a chaotic record's start segment can outlast its horizon): the departure
+  // says nothing of the equations, and the restarted runs judge them.
+  out.start_unfitted = v.start_segment > 0 && departs_at < time[std::min(v.start_segment, n) - 1];
+  out.sensitive = out.start_unfitted || *separates - time.front() <= 2 * (departs_at - time.front());
   out.period = fastest_period(v.recorded, time);
   if (!out.sensitive) return out;
 
-  // Runs of half the horizon, restarted from the record's state (moving arc, then estimated).
-  const std::size_t horizon = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), separates) - time.begin());
+  // Runs of half the horizon, restarted from the record's state (moving arc, then estimated), each
+  // compared with the record up to where its own displaced runs separate from it: the horizon
+  // depends on where in its orbit a chaotic solution starts.
+  const std::size_t horizon = static_cast<std::size_t>(std::lower_bound(time.begin(), time.end(), *separates) - time.begin());
   const std::size_t length = horizon / 2;
   if (length < kShortestRestart || length >= n || time[length] - time.front() < kRestartPeriods * out.period) return out;
-  out.judged = true;
   out.run_duration = time[length] - time.front();
   std::vector<ScaledSquares> errors(form.outputs.size()), deviations(form.outputs.size());
   std::vector<double> means(form.outputs.size(), 0.0);
@@ -150,6 +188,7 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
     for (double y : v.recorded[j]) if (std::isfinite(y)) means[j] += y, ++count;
     if (count) means[j] /= static_cast<double>(count);
   }
+  std::size_t compared = 0;
   for (std::size_t first = 0; first < n;) {
     // The last run takes what is left when less than half a run would remain.
     const std::size_t last = first + length + length / 2 > n ? n : first + length;
@@ -164,13 +203,22 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
                                           std::shared_ptr<const void>(std::shared_ptr<const void>{}, &v)));
     SimulateOptions estimate_with = run;
     estimate_with.method = options.method;  // as validate() estimates the free run's start
-    run.initial = estimate_initial_state(normalized, form, estimate_with, recorded, start_segment_samples(last - first)).initial;
+    const InitialStateEstimate estimate = estimate_initial_state(normalized, form, estimate_with, recorded, start_segment_samples(last - first));
+    run.initial = estimate.initial;
     auto solved = simulate(normalized, form, run);
     if (!std::holds_alternative<SimulationSummary>(solved)) return std::nullopt;
     const SimulationSummary& s = std::get<SimulationSummary>(solved);
     out.completed = out.completed && s.completed();
+    std::size_t until = last - first;  // compared samples of this run
+    const std::vector<std::vector<double>> run_axes = uncertainty_axes(estimate, noise, options.tolerance);
+    if (s.completed() && run_axes.size() == form.state_size()) {
+      const std::optional<double> apart = separation(normalized, form, run, s, run_axes, spreads);
+      if (!apart) return std::nullopt;
+      until = static_cast<std::size_t>(std::lower_bound(run.time.begin(), run.time.end(), *apart) - run.time.begin());
+    }
+    compared += until;
     for (std::size_t j = 0; j < form.outputs.size(); ++j)
-      for (std::size_t i = 0; i < last - first; ++i) {
+      for (std::size_t i = 0; i < until; ++i) {
         const double y = recorded[j][i], e = y - s.outputs[j][i];
         if (!std::isfinite(y)) continue;
         deviations[j].add(y - means[j]);
@@ -179,6 +227,10 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
     ++out.runs;
     first = last;
   }
+  out.compared_share = static_cast<double>(compared) / static_cast<double>(n);
+  // Runs cut short everywhere would be too weak a test, like runs too short to begin with.
+  out.judged = out.compared_share >= kRestartComparedShare;
+  if (!out.judged) return out;
   out.follows = out.completed;
   for (std::size_t j = 0; j < form.outputs.size(); ++j) {
     const double d = deviations[j].norm();
@@ -278,12 +330,12 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
   v.truncated = prepared_run.truncated;
   v.recorded_state = named_state(form, o.initial);
   v.initial_method = options.initial_state;
-  std::vector<std::vector<double>> start_axes;  // the estimated start's uncertainty (sensitivity test)
+  std::optional<InitialStateEstimate> start_estimate;  // for the sensitivity test
   if (options.initial_state == InitialState::estimate && o.time.size() >= 2) {
     // With options.method (RK4 by default); ValidationOptions::choose_method changes only the free run below.
     const InitialStateEstimate estimate = estimate_initial_state(normalized, form, o, recorded, start_segment_samples(o.time.size()));
     o.initial = estimate.initial;
-    start_axes = estimate.uncertainty_axes;
+    start_estimate = estimate;
     v.start_segment = estimate.segment;
     v.estimate_iterations = estimate.iterations;
   }
@@ -342,7 +394,12 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     std::optional<double> departs;
     for (const auto& r : v.outputs)
       if (!r.follows && r.departs_at && (!departs || *r.departs_at < *departs)) departs = r.departs_at;
-    if (departs) v.restarted = restart_within_horizon(normalized, form, record, prepared_run, o, v, start_axes, *departs, options);
+    if (departs && start_estimate) {
+      std::vector<double> noise;  // each output's noise level over the compared samples
+      for (const Column& y : v.recorded) noise.push_back(estimate_noise_level(y).sigma);
+      v.restarted = restart_within_horizon(normalized, form, record, prepared_run, o, v, uncertainty_axes(*start_estimate, noise, options.tolerance),
+                                           noise, *departs, options);
+    }
     if (v.restarted && v.restarted->judged) v.follows = v.restarted->follows;
   }
   if (v.simulation.completed()) {
@@ -380,15 +437,25 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
   const std::string twin =
       separates_at <= start
           ? "the initial state estimated over the start segment is itself uncertain by more than a tenth of an output's spread"
-          : fmt::format("started one standard deviation of the estimated initial state away, their own solution separates from this one by t = {:.4g}",
+          : fmt::format("started one standard deviation of the estimated initial state away (for the record's noise), their own solution "
+                        "separates from this one by t = {:.4g}",
                         separates_at);
+  const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs, each from a state estimated over its start "
+                                            "and compared up to where its own displaced runs separate from it: {:.3g}% of the record)",
+                                            run_duration, runs, 100 * compared_share);
   if (!judged)
     return fmt::format("The fitted equations, solved from the record, do not follow it: {}. But they are as sensitive to their initial state ({}), "
-                       "so the departure may be that sensitivity rather than the model; runs restarted from the record within that horizon "
-                       "would be shorter than {:g} periods of the output that varies fastest ({:.4g}), too short to judge the model by.",
-                       free_run, twin, kRestartPeriods, period);
-  const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs, each from a state estimated over its start)",
-                                            run_duration, runs);
+                       "so the departure may be that sensitivity rather than the model; {}.",
+                       free_run, twin,
+                       runs == 0 ? fmt::format("runs restarted from the record within that horizon would be shorter than {:g} periods of the "
+                                               "output that varies fastest ({:.4g}), too short to judge the model by",
+                                               kRestartPeriods, period)
+                                 : fmt::format("{}, less than {:g}%, too little to judge the model by", runs_text, 100 * kRestartComparedShare));
+  if (follows && start_unfitted)
+    return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "
+                       "they depart at t = {:.4g}, within the segment their initial state was estimated over, whose fit that start therefore is "
+                       "not; and {} (a chaotic or unstable solution). The free run: {}.",
+                       runs_text, fits, free_run_departs_at, twin, free_run);
   if (follows)
     return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "
                        "they depart at t = {:.4g}, as they must: {}, so no run from a state known only to within the record's noise can follow "

@@ -99,6 +99,10 @@ struct ValidationOptions {
 // pass. A stable system contracts the displacement, so a model that departs there is judged by the
 // free run as before.
 inline constexpr double kRestartPeriods = 2;
+// Each restarted run is compared with the record up to where its own displaced runs separate from
+// it (the horizon depends on where in its orbit a chaotic solution starts); the verdict is judged
+// only when the comparison covers at least this share of the record.
+inline constexpr double kRestartComparedShare = 0.5;
 inline constexpr std::size_t kShortestRestart = 20;  // samples in each restarted run, at least
 
 // The solver of a validation's free run: the adaptive stepper (Odeint's dopri5 with dense output
@@ -144,10 +148,12 @@ struct ValidationSummary {
     double start = 0;                // t of the free run's first sample
     double free_run_departs_at = 0;  // the first departure of an output that does not follow
     double separates_at = 0;         // where the first displaced run departs from the free run
-    bool sensitive = false;          // separates_at - t0 <= 2 (free_run_departs_at - t0)
-    double period = 0;               // of the fastest output (twice its mean time between mean crossings)
-    bool judged = false;             // sensitive, and the restarted runs long enough to judge by
+    bool start_unfitted = false;     // the free run departs within its own start segment
+    bool sensitive = false;          // separates_at - t0 <= 2 (free_run_departs_at - t0), or start_unfitted
+    double period = 0;               // of the fastest output (twice the duration over its turning points)
+    bool judged = false;             // sensitive, and the restarted runs long enough and compared enough to judge by
     std::size_t runs = 0;
+    double compared_share = 0;       // of the samples, compared before each run's own displaced runs separate
     double run_duration = 0;         // of each run but perhaps the last (time units)
     std::vector<std::pair<std::string, double>> fit_percent;  // per output, over every restarted run
     bool completed = true;           // every restarted run reached its end

@@ -2,7 +2,7 @@
 // follows a Lorenz record for long, whatever the parameters, because the initial state is known
 // only to within the noise and the solution amplifies that error. The sensitivity test (runs from
 // the estimated start displaced along its uncertainty's axes) must see that, and the restarted
-// runs must then tell the true equations (follow) from wrong ones (do not); a stable system's
+// runs must then find the true equations to follow; wrong ones must still be said not to; a stable system's
 // departure must stay the model's.
 //
 // How: Lorenz's equations (sigma 10, rho 28, beta 8/3) solved by RK4 at ten steps per sample,

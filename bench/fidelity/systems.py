@@ -50,6 +50,11 @@ class System:
     # the models declare; the library then declares its parameters too (library_params).
     guesses: dict = field(default_factory=dict)
     library_params: list = field(default_factory=list)
+    # A chaotic system (> 0): no free run follows its record for long, however right the equations,
+    # so the verdict's truth is the fitted equations run from the true state every this many time
+    # units (run.py), and `rhs_with(parameters)` gives their right-hand side.
+    chaotic_horizon: float = 0.0
+    rhs_with: object = None
 
 
 def _duffing():
@@ -236,6 +241,32 @@ def _pendulum_length():
               "equation error (variable projection), `set refine = simulation` estimates it with the others")
 
 
+def _lorenz():
+    sigma, rho, beta = 10.0, 28.0, 8.0 / 3.0
+
+    def rhs_with(p):
+        return lambda t, s, u: [p["a"] * s[1] + p["b"] * s[0], p["r"] * s[0] + p["c"] * s[0] * s[2] + p["d"] * s[1],
+                                p["e"] * s[0] * s[1] + p["g"] * s[2]]
+
+    truth = {"a": sigma, "b": -sigma, "r": rho, "c": -1.0, "d": -1.0, "e": 1.0, "g": -beta}
+    quadratic = "{0}1*x + {0}2*y + {0}3*z + {0}4*x*y + {0}5*x*z + {0}6*y*z + {0}7*x^2 + {0}8*y^2 + {0}9*z^2 + {0}0"
+    return System(
+        name="lorenz", title="Lorenz system (chaotic, three outputs)",
+        inputs={}, outputs=["x", "y", "z"], states=["x", "y", "z"], output_state={"x": 0, "y": 1, "z": 2},
+        x0=[-8.0, 7.0, 27.0], step=0.01, samples=5000, substeps=20,
+        truth=truth,
+        equations="x' = a*y + b*x\ny' = r*x + c*x*z + d*y\nz' = e*x*y + g*z",
+        # The quadratic library of equation discovery (SINDy's Lorenz example), the true terms named
+        # by the true parameters and left out of the p/q/w series.
+        library="x' = " + quadratic.format("p").replace("p1*x", "b*x").replace("p2*y", "a*y") + "\n"
+                "y' = " + quadratic.format("q").replace("q1*x", "r*x").replace("q2*y", "d*y").replace("q5*x*z", "c*x*z") + "\n"
+                "z' = " + quadratic.format("w").replace("w3*z", "g*z").replace("w4*x*y", "e*x*y"),
+        library_truth={1: {"a", "b"}, 2: {"r", "c", "d"}, 3: {"e", "g"}},
+        rhs=rhs_with(truth), issue13=False, chaotic_horizon=2.0, rhs_with=rhs_with,
+        notes="sigma 10, rho 28, beta 8/3 from (-8, 7, 27): 50 time units, about 65 oscillations of z; largest Lyapunov "
+              "exponent about 0.9, so a free run departs after a few time units from any state known to within the noise")
+
+
 SYSTEMS = [_duffing(), _van_der_pol(), _lotka_volterra(), _third_order(), _piecewise(), _stiff(),
-           _process(), _pendulum(), _process_held(), _pendulum_length()]
+           _process(), _pendulum(), _process_held(), _pendulum_length(), _lorenz()]
 BY_NAME = {s.name: s for s in SYSTEMS}

@@ -4,15 +4,17 @@ chosen from the data) on the records of tests/data/fidelity/, the largest relati
 against truth.json held under a tolerance per case, and `sidc select` on the case's library picking
 exactly the true terms.
 
-Usage: pin_fidelity.py SIDC CASE TOLERANCE [--refine]   (TOLERANCE a fraction: 0.006 = 0.6%)
+Usage: pin_fidelity.py SIDC CASE TOLERANCE [--refine] [--follows]   (TOLERANCE a fraction: 0.006 = 0.6%)
 With --refine the fit is refined by the output error (issue 15) and the refined estimates are
-judged; each refined 95% interval must then also hold the truth.
+judged; each refined 95% interval must then also hold the truth. With --follows the validation's
+verdict must be that the fitted equations follow the record (a chaotic record's restarted runs).
 The tolerances are about three times what this sidc measures (docs/accuracy.md), so a real loss of accuracy
 fails and rounding does not."""
 import json, os, re, shutil, subprocess, sys, tempfile
 
 sidc, case, tolerance = sys.argv[1], sys.argv[2], float(sys.argv[3])
-refine = sys.argv[4:] == ["--refine"]
+refine = "--refine" in sys.argv[4:]
+follows = "--follows" in sys.argv[4:]
 source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "fidelity", case)
 truth = json.load(open(os.path.join(source, "truth.json")))
 with tempfile.TemporaryDirectory() as work:
@@ -44,6 +46,11 @@ with tempfile.TemporaryDirectory() as work:
                 sys.exit(f"{case}: the refined 95% interval of {parameter} misses the truth: {estimate} +- {1.96 * standard_error} "
                          f"against {true}\n{run.stdout}")
     print(f"{case}: largest relative parameter error {100 * worst:.4g}% ({name}), tolerance {100 * tolerance:.4g}%")
+    if follows:
+        verdicts = [r["verdict"]["follows"] for r in (fit.get("validation") or {}).get("records", [])]
+        if not verdicts or not all(verdicts):
+            sys.exit(f"{case}: the validation says the fitted equations do not follow the record\n{run.stdout}")
+        print(f"{case}: the validation says the fitted equations follow the record")
     if worst > tolerance:
         sys.exit(f"{case}: {100 * worst:.4g}% exceeds {100 * tolerance:.4g}%\n{run.stdout}")
     select = subprocess.run([sidc, "select", "library.sid", "--out", "sel"], cwd=work, capture_output=True, text=True, timeout=300)

@@ -300,6 +300,7 @@ nlohmann::ordered_json validation_json(const FitValidation& v, std::size_t fitte
                    {"start_unfitted", r->start_unfitted}, {"sensitive", r->sensitive},
                    {"fastest_period", r->period}, {"judged", r->judged},
                    {"runs", r->runs}, {"run_duration", r->runs ? ordered_json(r->run_duration) : ordered_json(nullptr)},
+                   {"run_every", r->runs ? ordered_json(r->run_every) : ordered_json(nullptr)},
                    {"compared_share", r->runs ? ordered_json(r->compared_share) : ordered_json(nullptr)},
                    {"completed", r->completed}, {"follows", r->follows}, {"outputs", fits}};
     }

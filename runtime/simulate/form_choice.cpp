@@ -28,7 +28,8 @@ std::optional<std::vector<double>> piece_errors(const ir::Model& normalized, con
   std::vector<const SampledRecord*> checked;
   for (const auto& p : pieces) checked.push_back(&p);
   // Every piece is a record given to be compared with: its problem is the candidate's failure.
-  const FitValidation v = validate_fit(normalized, explicit_form, summary, checked, 0, options.evaluation, validate_samples, InitialState::estimate);
+  const FitValidation v = validate_fit(normalized, explicit_form, summary, checked, 0, options.evaluation, validate_samples, InitialState::estimate,
+                                      nullptr, "refined by the output error", {}, false);
   if (v.failed_record) {
     note = v.failed_record->message;
     return std::nullopt;

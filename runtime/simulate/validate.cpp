@@ -188,10 +188,15 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
     for (double y : v.recorded[j]) if (std::isfinite(y)) means[j] += y, ++count;
     if (count) means[j] /= static_cast<double>(count);
   }
-  std::size_t compared = 0;
+  // At most kMostRestartedRuns runs, evenly spread (every stride-th stretch of `length` samples),
+  // so that a long record with a short horizon costs a bounded number of estimates and runs.
+  const std::size_t stretches = n / length, stride = (stretches + kMostRestartedRuns - 1) / kMostRestartedRuns;
+  out.run_every = static_cast<double>(stride) * out.run_duration;
+  std::size_t compared = 0, covered = 0;
   for (std::size_t first = 0; first < n;) {
     // The last run takes what is left when less than half a run would remain.
     const std::size_t last = first + length + length / 2 > n ? n : first + length;
+    covered += last - first;
     auto guess = initial_state_from_record(form, record, prepared.state_evaluation, prepared.start + first, true);
     if (!std::holds_alternative<std::map<std::string, std::vector<double>>>(guess)) return std::nullopt;
     SimulateOptions run = free_run.samples(first, last);
@@ -225,9 +230,9 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
         if (std::isfinite(e)) errors[j].add(e);
       }
     ++out.runs;
-    first = last;
+    first = last == n ? n : first + stride * length;
   }
-  out.compared_share = static_cast<double>(compared) / static_cast<double>(n);
+  out.compared_share = static_cast<double>(compared) / static_cast<double>(covered);
   // Runs cut short everywhere would be too weak a test, like runs too short to begin with.
   out.judged = out.compared_share >= kRestartComparedShare;
   if (!out.judged) return out;
@@ -440,9 +445,10 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
           : fmt::format("started one standard deviation of the estimated initial state away (for the record's noise), their own solution "
                         "separates from this one by t = {:.4g}",
                         separates_at);
-  const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs, each from a state estimated over its start "
-                                            "and compared up to where its own displaced runs separate from it: {:.3g}% of the record)",
-                                            run_duration, runs, 100 * compared_share);
+  const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs{}, each from a state estimated over its start "
+                                            "and compared up to where its own displaced runs separate from it: {:.3g}% of their samples)",
+                                            run_every, runs, run_every > run_duration ? fmt::format(" of {:.4g}", run_duration) : "",
+                                            100 * compared_share);
   if (!judged)
     return fmt::format("The fitted equations, solved from the record, do not follow it: {}. But they are as sensitive to their initial state ({}), "
                        "so the departure may be that sensitivity rather than the model; {}.",
@@ -493,7 +499,8 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples, InitialState initial_state, const std::vector<double>* refined,
                            const std::string& refined_by,
-                           const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress) {
+                           const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress,
+                           bool check_sensitivity) {
   FitValidation v;
   v.max_samples = max_samples;
   if (!summary.is_solution_usable()) {
@@ -513,7 +520,7 @@ FitValidation validate_fit(const ir::Model& normalized, const std::variant<Expli
   o.max_samples = max_samples;
   o.initial_state = initial_state;
   o.progress = progress;
-  o.check_sensitivity = true;
+  o.check_sensitivity = check_sensitivity;
   for (std::size_t r = 0; r < records.size(); ++r) {
     auto run = validate(normalized, std::get<ExplicitForm>(form), parameters, *records[r], o);
     if (auto* d = std::get_if<Diagnostic>(&run)) {

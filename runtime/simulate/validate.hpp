@@ -103,6 +103,8 @@ inline constexpr double kRestartPeriods = 2;
 // it (the horizon depends on where in its orbit a chaotic solution starts); the verdict is judged
 // only when the comparison covers at least this share of the record.
 inline constexpr double kRestartComparedShare = 0.5;
+// A long record with a short horizon is judged by at most this many restarted runs, evenly spread.
+inline constexpr std::size_t kMostRestartedRuns = 200;
 inline constexpr std::size_t kShortestRestart = 20;  // samples in each restarted run, at least
 
 // The solver of a validation's free run: the adaptive stepper (Odeint's dopri5 with dense output
@@ -153,8 +155,9 @@ struct ValidationSummary {
     double period = 0;               // of the fastest output (twice the duration over its turning points)
     bool judged = false;             // sensitive, and the restarted runs long enough and compared enough to judge by
     std::size_t runs = 0;
-    double compared_share = 0;       // of the samples, compared before each run's own displaced runs separate
+    double compared_share = 0;       // of the runs' samples, compared before each run's own displaced runs separate
     double run_duration = 0;         // of each run but perhaps the last (time units)
+    double run_every = 0;            // between run starts: run_duration, or a multiple on a record too long for kMostRestartedRuns
     std::vector<std::pair<std::string, double>> fit_percent;  // per output, over every restarted run
     bool completed = true;           // every restarted run reached its end
     bool follows = false;            // judged, completed and every output at kFollowsFitPercent or more
@@ -205,11 +208,14 @@ struct FitValidation {
 // compared with; the runs borrow their columns (grids, recorded outputs), so they must outlive the result. `form`: the compiled model's explicit form of `normalized`. `refined`: the
 // parameters (by the normalized model's parameter) to solve with instead of the fit's, and
 // `refined_by` how they were had ("refined by the output error", "of instrumental variables").
+// `check_sensitivity`: ValidationOptions::check_sensitivity (the form choice, which compares the
+// candidates' free runs on pieces, leaves it out).
 FitValidation validate_fit(const ir::Model& normalized, const std::variant<ExplicitForm, Diagnostic>& form, const FitSummary& summary,
                            const std::vector<const SampledRecord*>& records, std::size_t fitted_records, const EvaluationOptions& evaluation,
                            std::size_t max_samples, InitialState initial_state = InitialState::estimate,
                            const std::vector<double>* refined = nullptr, const std::string& refined_by = "refined by the output error",
-                           const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress = {});
+                           const std::function<void(const std::string& record, std::size_t done, std::size_t total)>& progress = {},
+                           bool check_sensitivity = true);
 
 // Section 2-4's test as a selection criterion (`sidc select --simulate`): the derivative form solved
 // with `values` for the parameters `subset` (the others 0; integration constants play no part) from each record (its initial

@@ -118,6 +118,11 @@ class System {
         if (auto d = weighted(form.coefficient[i][j], coefficient_[i][j])) return d;
       if (auto d = weighted(form.rest[i], rest_[i])) return d;
     }
+    // Each equation holds its own output's highest derivative only (x' = ..., y' = ..., z' = ...: the
+    // usual case): the solve is then a division per equation, with the LU's bits (below).
+    diagonal_ = true;
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = 0; j < k; ++j) diagonal_ = diagonal_ && (i == j || coefficient_[i][j].empty());
     if (sensitivities_) {
       parameters_ = o.parameters.size();
       coefficient_partial_.assign(k, std::vector<std::vector<Weighted>>(k));
@@ -271,6 +276,16 @@ class System {
       if (sensitivities_) {
         a_.setConstant(1, 1, a);
         z_.setConstant(1, -r / a);
+      }
+    } else if (diagonal_ && !sensitivities_) {
+      // What PartialPivLU gives for a diagonal matrix, without its allocations: no row swaps (each
+      // column's largest entry is on the diagonal, the others being 0), a unit L, and each
+      // highest derivative -r_i / a_ii (the triangular solves subtract exact zeros).
+      det = 1;
+      for (std::size_t i = 0; i < k; ++i) {
+        const double a = coefficient_[i][i].evaluate(at), r = rest_[i].evaluate(at);
+        det *= a;
+        out[state_offset_[i] + static_cast<std::size_t>(form_->outputs[i].order) - 1] = -r / a;
       }
     } else {
       a_.resize(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
@@ -511,6 +526,7 @@ class System {
   std::vector<std::vector<Weighted>> rest_partial_;                      // [i][state component]
   std::vector<std::vector<Weighted>> coefficient_nonlinear_;  // [i][j]: one part per nonlinear parameter
   std::vector<Weighted> rest_nonlinear_;                      // [i]: the same
+  bool diagonal_ = false;  // every equation holds only its own output's highest derivative
   Eigen::MatrixXd a_;  // the coefficients of the highest derivatives, and the sensitivity equations' right-hand side
   Eigen::VectorXd z_;      // the highest derivatives
   std::vector<double> g_, c_;  // the sensitivity equations' d(A z + r)/dx (k x n) and right-hand side (k x Q), row-major

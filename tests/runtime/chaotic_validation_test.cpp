@@ -46,19 +46,7 @@ SampledRecord lorenz_record(const Compiled& c, double share, unsigned seed) {
   o.initial = {{"x", {-8}}, {"y", {7}}, {"z", {27}}};
   o.time = testing::grid(0, 40, 0.01);
   o.substeps = 10;
-  auto run = simulate(*c.result.normalized, c.form, o);
-  EXPECT_TRUE(std::holds_alternative<SimulationSummary>(run));
-  SampledRecord record;
-  record.path = "lorenz.csv";
-  record.step = 0.01;
-  record.time = o.time;
-  std::mt19937 engine(seed);
-  for (std::size_t j = 0; j < 3; ++j) {
-    std::vector<double> y = std::get<SimulationSummary>(run).outputs[j];
-    testing::add_noise(y, share, engine);
-    record.signals[c.form.outputs[j].name] = std::move(y);
-  }
-  return record;
+  return testing::simulated_record(*c.result.normalized, c.form, o, "lorenz.csv", share, seed);
 }
 
 ValidationSummary validated(const Compiled& c, const std::vector<double>& parameters, const SampledRecord& record) {
@@ -118,16 +106,7 @@ TEST(ChaoticValidation, AStableSystemsDepartureStaysTheModels) {
   o.initial["y"] = {1, 0};
   o.time = testing::grid(0, 40, 0.02);
   o.substeps = 10;
-  auto run = simulate(*c.result.normalized, c.form, o);
-  ASSERT_TRUE(std::holds_alternative<SimulationSummary>(run));
-  SampledRecord record;
-  record.path = "oscillator.csv";
-  record.step = 0.02;
-  record.time = o.time;
-  std::vector<double> y = std::get<SimulationSummary>(run).outputs[0];
-  std::mt19937 engine(3);
-  testing::add_noise(y, 0.01, engine);
-  record.signals["y"] = std::move(y);
+  const SampledRecord record = testing::simulated_record(*c.result.normalized, c.form, o, "oscillator.csv", 0.01, 3);
   const ValidationSummary v = validated(c, {1, 0.05, 4.4}, record);
   EXPECT_FALSE(v.follows) << v.statement;
   ASSERT_FALSE(v.outputs[0].follows);

@@ -42,16 +42,7 @@ SampledRecord pendulum_record(const ir::Model& normalized, double share, unsigne
   o.initial["theta"] = {0.5, 0.0};
   o.time = grid(0, 40, 0.01);
   o.substeps = 8;
-  auto run = simulate(normalized, form_of(normalized), o);
-  EXPECT_TRUE(std::holds_alternative<SimulationSummary>(run));
-  SampledRecord record;
-  record.path = "pendulum.csv";
-  record.step = 0.01;
-  record.time = o.time;
-  std::vector<double> theta = std::get<SimulationSummary>(run).outputs[0];
-  std::mt19937 engine(seed);
-  if (share > 0) testing::add_noise(theta, share, engine);
-  record.signals["theta"] = std::move(theta);
+  SampledRecord record = testing::simulated_record(normalized, form_of(normalized), o, "pendulum.csv", share, seed);
   std::vector<double> u;  // the input's definition on the grid, as records.cpp fills it in
   for (const double t : record.time) u.push_back(2 * std::sin(0.7 * t) + 1.5 * std::sin(1.9 * t));
   record.signals["u"] = std::move(u);

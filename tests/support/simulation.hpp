@@ -1,5 +1,6 @@
 // Test support for the tests that simulate compiled models in-process (tests/runtime): a model
-// compiled to its normalized form, its explicit form, and a uniform time grid.
+// compiled to its normalized form, its explicit form, a uniform time grid, and a record made by
+// simulating a model, with noise.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 
 #include "compiler/explicit_form_pass.hpp"
 #include "compiler/pipeline.hpp"
+#include "runtime/simulate/simulate.hpp"
 
 namespace sidc::testing {
 
@@ -45,6 +47,27 @@ inline void add_noise(std::vector<double>& y, double share, std::mt19937& engine
   for (double v : y) squares += (v - mean) * (v - mean);
   std::normal_distribution<double> noise(0.0, share * std::sqrt(squares / static_cast<double>(y.size())));
   for (double& v : y) v += noise(engine);
+}
+
+// The outputs of `m` solved with `o` (its grid uniform) as a record named `path`, each output with
+// Gaussian noise of `share` of its standard deviation (add_noise, one engine seeded `seed`, the
+// outputs in the explicit form's order); inputs are the caller's to add. A failed run fails the test.
+inline SampledRecord simulated_record(const ir::Model& m, const ExplicitForm& f, const SimulateOptions& o, const std::string& path,
+                                      double share, unsigned seed) {
+  auto run = simulate(m, f, o);
+  EXPECT_TRUE(std::holds_alternative<SimulationSummary>(run)) << render(std::get<Diagnostic>(run));
+  SampledRecord record;
+  record.path = path;
+  record.step = o.time.size() > 1 ? o.time[1] - o.time[0] : 0.0;
+  record.time = o.time;
+  if (!std::holds_alternative<SimulationSummary>(run)) return record;
+  std::mt19937 engine(seed);
+  for (std::size_t j = 0; j < f.outputs.size(); ++j) {
+    std::vector<double> y = std::get<SimulationSummary>(run).outputs[j];
+    if (share > 0) add_noise(y, share, engine);
+    record.signals[f.outputs[j].name] = std::move(y);
+  }
+  return record;
 }
 
 }  // namespace sidc::testing

@@ -296,7 +296,7 @@ nlohmann::ordered_json validation_json(const FitValidation& v, std::size_t fitte
     if (const auto& r = run.restarted) {
       ordered_json fits = ordered_json::array();
       for (const auto& [output, fit] : r->fit_percent) fits.push_back({{"output", output}, {"fit_percent", fit}});
-      restarted = {{"free_run_departs_at", r->free_run_departs_at}, {"separates_at", r->separates_at},
+      restarted = {{"free_run_departs_at", r->free_run_departs_at}, {"separates_at", optional(r->separates_at)},
                    {"start_unfitted", r->start_unfitted}, {"sensitive", r->sensitive},
                    {"fastest_period", r->period}, {"judged", r->judged},
                    {"runs", r->runs}, {"run_duration", r->runs ? ordered_json(r->run_duration) : ordered_json(nullptr)},

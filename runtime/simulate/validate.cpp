@@ -1,7 +1,5 @@
 #include "runtime/simulate/validate.hpp"
 
-#include "runtime/operators/noise_level.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -440,11 +438,11 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
   for (const auto& [output, fit] : fit_percent)
     fits += fmt::format("{}fit {:.4g}% for {}{}", fits.empty() ? "" : ", ", fit, output, fit >= kFollowsFitPercent ? "" : fmt::format(" (below {:g}%)", kFollowsFitPercent));
   const std::string twin =
-      separates_at <= start
+      separates_at.value_or(start) <= start
           ? "the initial state estimated over the start segment is itself uncertain by more than a tenth of an output's spread"
           : fmt::format("started one standard deviation of the estimated initial state away (for the record's noise), their own solution "
                         "separates from this one by t = {:.4g}",
-                        separates_at);
+                        separates_at.value_or(start));
   const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs{}, each from a state estimated over its start "
                                             "and compared up to where its own displaced runs separate from it: {:.3g}% of their samples)",
                                             run_every, runs, run_every > run_duration ? fmt::format(" of {:.4g}", run_duration) : "",
@@ -454,8 +452,8 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
                        "so the departure may be that sensitivity rather than the model; {}.",
                        free_run, twin,
                        runs == 0 ? fmt::format("runs restarted from the record within that horizon would be shorter than {:g} periods of the "
-                                               "output that varies fastest ({:.4g}), too short to judge the model by",
-                                               kRestartPeriods, period)
+                                               "output that varies fastest ({:.4g}) or than {} samples, too short to judge the model by",
+                                               kRestartPeriods, period, kShortestRestart)
                                  : fmt::format("{}, less than {:g}%, too little to judge the model by", runs_text, 100 * kRestartComparedShare));
   if (follows && start_unfitted)
     return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "

@@ -149,7 +149,7 @@ struct ValidationSummary {
   struct Restarted {
     double start = 0;                // t of the free run's first sample
     double free_run_departs_at = 0;  // the first departure of an output that does not follow
-    double separates_at = 0;         // where the first displaced run departs from the free run
+    std::optional<double> separates_at;  // where the first displaced run departs from the free run; none when none does
     bool start_unfitted = false;     // the free run departs within its own start segment
     bool sensitive = false;          // separates_at - t0 <= 2 (free_run_departs_at - t0), or start_unfitted
     double period = 0;               // of the fastest output (twice the duration over its turning points)

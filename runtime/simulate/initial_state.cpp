@@ -144,7 +144,6 @@ InitialStateEstimate estimate_initial_state(const ir::Model& normalized, const E
   const auto rows = static_cast<Eigen::Index>(problem.rows());
   if (jacobian_at_hand && rows > n) {
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
-    out.residual_sd = std::sqrt(cost / static_cast<double>(rows - n));
     out.scales = problem.scales();
     for (Eigen::Index k = 0; k < n; ++k) {
       const double s = svd.singularValues()(k);

@@ -40,7 +40,6 @@ struct InitialStateEstimate {
   // form's order); empty when no Jacobian was formed or one direction leaves the segment unchanged.
   std::vector<std::vector<double>> uncertainty_axes;
   std::vector<double> scales;  // s_j, per output
-  double residual_sd = 0;      // the misfit's sigma, sqrt(cost / (rows - state size)), in units of s_j
 };
 
 // `options`: the whole run (grid, inputs, parameters, initial guess in `initial`); `recorded`:

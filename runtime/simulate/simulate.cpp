@@ -118,8 +118,8 @@ class System {
         if (auto d = weighted(form.coefficient[i][j], coefficient_[i][j])) return d;
       if (auto d = weighted(form.rest[i], rest_[i])) return d;
     }
-    // Each equation holds its own output's highest derivative only (x' = ..., y' = ..., z' = ...: the
-    // usual case): the solve is then a division per equation, with the LU's bits (below).
+    // Each equation holds its own output's highest derivative only (one output, or x' = ..., y' = ...,
+    // z' = ...: the usual case): the solve is then a division per equation, with the LU's bits.
     diagonal_ = true;
     for (std::size_t i = 0; i < k; ++i)
       for (std::size_t j = 0; j < k; ++j) diagonal_ = diagonal_ && (i == j || coefficient_[i][j].empty());
@@ -269,23 +269,25 @@ class System {
       for (int m = 0; m + 1 < form_->outputs[j].order; ++m) out[base + static_cast<std::size_t>(m)] = state[base + static_cast<std::size_t>(m) + 1];
     }
     double det = 0;
-    if (k == 1) {
-      const double a = coefficient_[0][0].evaluate(at), r = rest_[0].evaluate(at);
-      det = a;
-      out[state_offset_[0] + static_cast<std::size_t>(form_->outputs[0].order) - 1] = -r / a;
+    if (diagonal_) {
+      // What PartialPivLU gives for a diagonal matrix (one output, or equations that each hold only
+      // their own output's highest derivative), without its allocations: no row swaps (each
+      // column's largest entry is on the diagonal, the others being 0), a unit L, and each highest
+      // derivative -r_i / a_ii (the triangular solves subtract exact zeros).
       if (sensitivities_) {
-        a_.setConstant(1, 1, a);
-        z_.setConstant(1, -r / a);
+        a_.setZero(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
+        z_.resize(static_cast<Eigen::Index>(k));
       }
-    } else if (diagonal_ && !sensitivities_) {
-      // What PartialPivLU gives for a diagonal matrix, without its allocations: no row swaps (each
-      // column's largest entry is on the diagonal, the others being 0), a unit L, and each
-      // highest derivative -r_i / a_ii (the triangular solves subtract exact zeros).
       det = 1;
       for (std::size_t i = 0; i < k; ++i) {
         const double a = coefficient_[i][i].evaluate(at), r = rest_[i].evaluate(at);
         det *= a;
         out[state_offset_[i] + static_cast<std::size_t>(form_->outputs[i].order) - 1] = -r / a;
+        if (sensitivities_) {
+          const auto ii = static_cast<Eigen::Index>(i);
+          a_(ii, ii) = a;
+          z_(ii) = -r / a;
+        }
       }
     } else {
       a_.resize(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));

@@ -75,15 +75,16 @@ struct ScaledSquares {
 // The period of the output that varies fastest: for each, twice the record's duration over the
 // number of its turning points, counted as a zig-zag does (a maximum or minimum counts once the
 // output has moved away from it by `band`: a quarter of its standard deviation, and at least five
-// times its noise level, so noise makes no turns). Turning points rather than crossings of the
+// times its noise level `noise`, so noise makes no turns). Turning points rather than crossings of the
 // mean: an output that oscillates within one well of a double well (a chaotic Duffing
 // oscillator) crosses its mean only when it changes wells. The record's duration for an output
 // that never turns.
-double fastest_period(const std::vector<Column>& recorded, std::span<const double> time) {
+double fastest_period(const std::vector<Column>& recorded, const std::vector<double>& noise, std::span<const double> time) {
   const double duration = time.back() - time.front();
   double fastest = duration;
-  for (const Column& y : recorded) {
-    const double band = std::max(0.25 * standard_deviation(y), 5 * estimate_noise_level(y).sigma);
+  for (std::size_t j = 0; j < recorded.size(); ++j) {
+    const Column& y = recorded[j];
+    const double band = std::max(0.25 * standard_deviation(y), 5 * noise[j]);
     if (!(band > 0) || !std::isfinite(band)) continue;
     int direction = 0;  // +1 rising from the last turn, -1 falling; 0 before the first swing
     double extreme = NAN, high = -INFINITY, low = INFINITY;
@@ -145,13 +146,15 @@ std::optional<double> separation(const ir::Model& normalized, const ExplicitForm
 }
 
 // The sensitivity test and the restarted runs of ValidationSummary::Restarted, for a completed
-// free run `v` of `prepared` (its options with the estimated start, the free-run method) that
-// departs at `departs_at`. nullopt when the test cannot be made (no uncertainty axes, a failed run).
+// free run `v` of `prepared` (its options with the estimated start and the free-run method; its
+// recorded outputs now in v.recorded) that departs at `departs_at`. nullopt when the test cannot
+// be made (no uncertainty axes, a failed run).
 std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Model& normalized, const ExplicitForm& form,
                                                                    const SampledRecord& record, const RecordRun& prepared,
-                                                                   const SimulateOptions& free_run, const ValidationSummary& v,
-                                                                   const std::vector<std::vector<double>>& axes, const std::vector<double>& noise,
-                                                                   double departs_at, const ValidationOptions& options) {
+                                                                   const ValidationSummary& v, const std::vector<std::vector<double>>& axes,
+                                                                   const std::vector<double>& noise, double departs_at,
+                                                                   const ValidationOptions& options) {
+  const SimulateOptions& free_run = prepared.options;
   const std::span<const double> time = free_run.time;
   const std::size_t n = time.size();
   if (axes.size() != form.state_size() || n < 2 * kShortestRestart) return std::nullopt;
@@ -169,7 +172,7 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
   // says nothing of the equations, and the restarted runs judge them.
   out.start_unfitted = v.start_segment > 0 && departs_at < time[std::min(v.start_segment, n) - 1];
   out.sensitive = out.start_unfitted || *separates - time.front() <= 2 * (departs_at - time.front());
-  out.period = fastest_period(v.recorded, time);
+  out.period = fastest_period(v.recorded, noise, time);
   if (!out.sensitive) return out;
 
   // Runs of half the horizon, restarted from the record's state (moving arc, then estimated), each
@@ -180,12 +183,6 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
   if (length < kShortestRestart || length >= n || time[length] - time.front() < kRestartPeriods * out.period) return out;
   out.run_duration = time[length] - time.front();
   std::vector<ScaledSquares> errors(form.outputs.size()), deviations(form.outputs.size());
-  std::vector<double> means(form.outputs.size(), 0.0);
-  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
-    std::size_t count = 0;
-    for (double y : v.recorded[j]) if (std::isfinite(y)) means[j] += y, ++count;
-    if (count) means[j] /= static_cast<double>(count);
-  }
   // At most kMostRestartedRuns runs, evenly spread (every stride-th stretch of `length` samples),
   // so that a long record with a short horizon costs a bounded number of estimates and runs.
   const std::size_t stretches = n / length, stride = (stretches + kMostRestartedRuns - 1) / kMostRestartedRuns;
@@ -224,7 +221,7 @@ std::optional<ValidationSummary::Restarted> restart_within_horizon(const ir::Mod
       for (std::size_t i = 0; i < until; ++i) {
         const double y = recorded[j][i], e = y - s.outputs[j][i];
         if (!std::isfinite(y)) continue;
-        deviations[j].add(y - means[j]);
+        deviations[j].add(y - v.outputs[j].mean);
         if (std::isfinite(e)) errors[j].add(e);
       }
     ++out.runs;
@@ -365,6 +362,7 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
       mean += y[i];
     }
     if (r.samples) mean /= static_cast<double>(r.samples);
+    r.mean = mean;
     // Squares taken relative to the largest error or deviation, so that a record in units of 1e200
     // (or 1e-200) gives the same fit % and a finite RMS error.
     double scale = 0;
@@ -400,8 +398,8 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     if (departs && start_estimate) {
       std::vector<double> noise;  // each output's noise level over the compared samples
       for (const Column& y : v.recorded) noise.push_back(estimate_noise_level(y).sigma);
-      v.restarted = restart_within_horizon(normalized, form, record, prepared_run, o, v, uncertainty_axes(*start_estimate, noise, options.tolerance),
-                                           noise, *departs, options);
+      v.restarted = restart_within_horizon(normalized, form, record, prepared_run, v, uncertainty_axes(*start_estimate, noise, options.tolerance), noise,
+                                           *departs, options);
     }
     if (v.restarted && v.restarted->judged) v.follows = v.restarted->follows;
   }
@@ -455,16 +453,17 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
                                                "output that varies fastest ({:.4g}) or than {} samples, too short to judge the model by",
                                                kRestartPeriods, period, kShortestRestart)
                                  : fmt::format("{}, less than {:g}%, too little to judge the model by", runs_text, 100 * kRestartComparedShare));
-  if (follows && start_unfitted)
+  if (follows) {
+    const std::string why = start_unfitted ? fmt::format("within the segment their initial state was estimated over, whose fit that start therefore "
+                                                         "is not; and {} (a chaotic or unstable solution)",
+                                                         twin)
+                                           : fmt::format("as they must: {}, so no run from a state known only to within the record's noise can "
+                                                         "follow it for longer (a chaotic or unstable solution)",
+                                                         twin);
     return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "
-                       "they depart at t = {:.4g}, within the segment their initial state was estimated over, whose fit that start therefore is "
-                       "not; and {} (a chaotic or unstable solution). The free run: {}.",
-                       runs_text, fits, free_run_departs_at, twin, free_run);
-  if (follows)
-    return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "
-                       "they depart at t = {:.4g}, as they must: {}, so no run from a state known only to within the record's noise can follow "
-                       "it for longer (a chaotic or unstable solution). The free run: {}.",
-                       runs_text, fits, free_run_departs_at, twin, free_run);
+                       "they depart at t = {:.4g}, {}. The free run: {}.",
+                       runs_text, fits, free_run_departs_at, why, free_run);
+  }
   return fmt::format("The fitted equations, solved from the record, do not follow it: {}. Nor when {}, within the horizon their own "
                      "sensitivity to the initial state allows ({}): {}{}.",
                      free_run, runs_text, twin, fits, completed ? "" : "; a restarted run could not be solved to its end");

@@ -127,7 +127,8 @@ struct OutputValidation {
   double percent_error = 0;       // eq. 4-1.5
   double fit_percent = 0;         // 100 (1 - ||y - yhat|| / ||y - mean(y)||)
   double rms_error = 0;
-  double spread = 0;              // the recorded output's standard deviation about its mean (samples compared)
+  double mean = 0;                // the recorded output's mean and standard deviation about it (samples compared)
+  double spread = 0;
   bool follows = false;               // fit % >= kFollowsFitPercent and the run completed
   std::optional<double> departs_at;   // see kDepartureShare; the stop when it stopped first; none when it never departs
 };

@@ -568,14 +568,19 @@ bool any_sign_change(const std::vector<double>& a, const std::vector<double>& b)
 }
 
 // The first offending state component, or nullopt when the state is fine.
-std::optional<std::string> divergence(const State& s, const ExplicitForm& form, const std::vector<std::size_t>& offsets, double bound, double t) {
+// `scale`: SimulateOptions::state_scale (empty: 1).
+std::optional<std::string> divergence(const State& s, const ExplicitForm& form, const std::vector<std::size_t>& offsets, double bound,
+                                      const std::vector<double>& scale, double t) {
   for (std::size_t j = 0; j < form.outputs.size(); ++j)
     for (int m = 0; m < form.outputs[j].order; ++m) {
-      const double v = s[offsets[j] + static_cast<std::size_t>(m)];
-      if (std::abs(v) <= bound) continue;  // the name is made only for a bad one: this runs every step
+      const std::size_t i = offsets[j] + static_cast<std::size_t>(m);
+      const double v = s[i], limit = scale.empty() ? bound : bound * scale[i];
+      if (std::abs(v) <= limit) continue;  // the name is made only for a bad one: this runs every step
       const std::string name = prime(form.outputs[j].name, m);
       if (!std::isfinite(v)) return fmt::format("the simulation diverged: `{}` is not finite at t = {:.6g}", name, t);
-      return fmt::format("the simulation diverged: |{}| = {:.3g} exceeds {:.3g} at t = {:.6g}", name, std::abs(v), bound, t);
+      if (scale.empty()) return fmt::format("the simulation diverged: |{}| = {:.3g} exceeds {:.3g} at t = {:.6g}", name, std::abs(v), bound, t);
+      return fmt::format("the simulation diverged: |{}| = {:.3g} exceeds {:.3g} times its size on the record ({:.3g}) at t = {:.6g}", name,
+                         std::abs(v), bound, scale[i], t);
     }
   return std::nullopt;
 }
@@ -595,6 +600,8 @@ bool SimulateOptions::is_valid(std::string* why) const {
   for (const auto& [name, v] : inputs)
     if (v.size() != time.size()) return fail(fmt::format("input `{}` has {} values for {} times", name, v.size(), time.size()));
   if (!(divergence_bound > 0)) return fail("the divergence bound must be positive");
+  for (double x : state_scale)
+    if (!(x > 0) || !std::isfinite(x)) return fail("a state scale must be a positive number");
   return true;
 }
 
@@ -609,6 +616,7 @@ SimulateOptions SimulateOptions::samples(std::size_t first, std::size_t last) co
   out.relative_tolerance = relative_tolerance;
   out.locate_switches = locate_switches;
   out.divergence_bound = divergence_bound;
+  out.state_scale = state_scale;
   out.parameters = parameters;
   out.initial = initial;
   const std::size_t end = std::min(last, time.size()), begin = std::min(first, end);
@@ -667,6 +675,8 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
   State s = state_vector(form, o.initial);
   s.resize(system.vector_size(), 0.0);
   const std::size_t n_state = system.state_size(), columns = system.sensitivity_columns();
+  if (!o.state_scale.empty() && o.state_scale.size() != n_state)
+    throw std::logic_error(fmt::format("simulate: {} state scales for {} state components", o.state_scale.size(), n_state));
   summary.sensitivity_columns = columns;
   if (!columns) summary.sensitivity.clear();
   if (columns) {
@@ -689,7 +699,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
     summary.stopped_at = t;
   };
   record(0, s);
-  if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, o.time[0])) {
+  if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, o.state_scale, o.time[0])) {
     stop(SimulationSummary::Status::diverged, *bad, o.time[0]);
     return std::nullopt;
   }
@@ -740,7 +750,7 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
           s.swap(next);
           t = step == end - t ? end : t + step;
           ++summary.steps;
-          if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
+          if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, o.state_scale, t)) {
             stop(SimulationSummary::Status::diverged, *bad, t);
             summary.right_hand_sides = system.evaluations;
             return std::nullopt;
@@ -752,8 +762,24 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
     }
   } else {
     namespace odeint = boost::numeric::odeint;
-    auto rhs = [&](const State& x, State& dx, double t) {
-      if (!system.derivative(t, x.data(), dx.data())) std::fill(dx.begin(), dx.end(), kNaN);
+    // The stepper's state is the state divided by its scale (SimulateOptions::state_scale), the
+    // sensitivities of each component by that component's; with no scale, the state itself.
+    State scale;
+    if (!o.state_scale.empty()) {
+      scale.resize(s.size());
+      for (std::size_t i = 0; i < s.size(); ++i) scale[i] = o.state_scale[i % n_state];
+      for (std::size_t i = 0; i < s.size(); ++i) s[i] /= scale[i];
+    }
+    State x_of_z(scale.size());
+    auto unscaled = [&](const State& z) -> const State& {
+      if (scale.empty()) return z;
+      for (std::size_t i = 0; i < z.size(); ++i) x_of_z[i] = z[i] * scale[i];
+      return x_of_z;
+    };
+    auto rhs = [&](const State& z, State& dz, double t) {
+      if (!system.derivative(t, unscaled(z).data(), dz.data())) std::fill(dz.begin(), dz.end(), kNaN);
+      else if (!scale.empty())
+        for (std::size_t i = 0; i < dz.size(); ++i) dz[i] /= scale[i];
     };
     const double first_step = n > 1 ? (o.time[1] - o.time[0]) / 10 : 1e-3;
     // An adaptive stepper creeping towards a singularity takes ever smaller steps and never
@@ -788,13 +814,13 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
             stop(SimulationSummary::Status::singular, *system.trouble, system.trouble_time);
             return;
           }
-          if (auto bad = divergence(s, form, system.state_offset_, o.divergence_bound, t)) {
+          if (auto bad = divergence(unscaled(s), form, system.state_offset_, o.divergence_bound, o.state_scale, t)) {
             stop(SimulationSummary::Status::diverged, *bad, t);
             return;
           }
         }
         t = o.time[row];
-        record(row, s);
+        record(row, unscaled(s));
         if (o.progress && (row % 65536 == 0 || row + 1 == n)) o.progress(row + 1, n);
       }
     };
@@ -820,14 +846,14 @@ std::optional<Diagnostic> simulate_into(const ir::Model& normalized, const Expli
               summary.right_hand_sides = system.evaluations;
               return std::nullopt;
             }
-            if (auto bad = divergence(stepper.current_state(), form, system.state_offset_, o.divergence_bound, stepper.current_time())) {
+            if (auto bad = divergence(unscaled(stepper.current_state()), form, system.state_offset_, o.divergence_bound, o.state_scale, stepper.current_time())) {
               stop(SimulationSummary::Status::diverged, *bad, stepper.current_time());
               summary.right_hand_sides = system.evaluations;
               return std::nullopt;
             }
           }
           stepper.calc_state(o.time[row], s);
-          record(row, s);
+          record(row, unscaled(s));
           if (o.progress && (row % 65536 == 0 || row + 1 == n)) o.progress(row + 1, n);
         }
       } else {

@@ -45,7 +45,12 @@ struct SimulateOptions {
   Stepper stepper = Stepper::dopri5;
   double absolute_tolerance = 1e-9, relative_tolerance = 1e-9;  // adaptive
   bool locate_switches = true;                                  // rk4: step to each guard switch
-  double divergence_bound = 1e8;  // |state| beyond this is divergence
+  double divergence_bound = 1e8;  // |state| beyond this (times its state_scale) is divergence
+  // Each state component's size (the explicit form's state order, per output y, y', ...); empty: all
+  // 1. The adaptive stepper solves for the state divided by it, so its absolute tolerance is relative
+  // to each component's size: a record in micrometres (y ~ 1e-7) is solved as accurately as one of
+  // order 1, where an absolute tolerance of 1e-9 would let the stepper take any step.
+  std::vector<double> state_scale;
 
   std::vector<double> parameters;  // by index into the normalized model's parameters
   // Initial state per output: y(t0), y'(t0), ..., y^(n-1)(t0) (n values, the output's order).

@@ -314,6 +314,14 @@ std::variant<RecordRun, Diagnostic> record_run(const ir::Model& normalized, cons
   run.start = start;
   run.truncated = static_cast<std::size_t>(to) < record.time.size();
   for (const auto& out : form.outputs) run.recorded.push_back(on_grid(record.signals.at(out.name)));
+  // Each output's size on the record scales its state components' tolerance and divergence bound
+  // (SimulateOptions::state_scale): the tolerance of 1e-9 means "of the signal", whatever its unit.
+  for (std::size_t j = 0; j < form.outputs.size(); ++j) {
+    double size = 0;
+    for (double y : run.recorded[j])
+      if (std::isfinite(y)) size = std::max(size, std::abs(y));
+    o.state_scale.insert(o.state_scale.end(), static_cast<std::size_t>(form.outputs[j].order), size > 0 ? size : 1.0);
+  }
   return run;
 }
 

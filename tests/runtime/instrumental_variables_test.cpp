@@ -188,8 +188,9 @@ TEST(InstrumentalVariables, ChangesNothingOnAnExactRecord) {
 }
 
 // y' = 0.5 y + x, x = sin t, from y(0) = 0: y = 0.8 e^(t/2) - 0.4 sin t - 0.8 cos t, fitted on
-// [0, 10] (`set to`), recorded to t = 60. The true equations grow past the divergence bound
-// (|y| > 1e8) near t = 37 when solved over the whole record.
+// [0, 10] (`set to`), recorded to t = 60 by a sensor that saturated at its value at t = 10 (119).
+// The true equations grow past the divergence bound (1e8 of the record's size: |y| > 1.19e10) near
+// t = 47 when solved over the whole record.
 const char* kUnstable = "input x = sin(t)\noutput y\nparam a, b\nset integrate = 1\nset to = 10\ny' + a*y = b*x\n";
 
 SampledRecord unstable_record() {
@@ -197,8 +198,9 @@ SampledRecord unstable_record() {
   record.path = "unstable.csv";
   record.step = 0.02;
   record.time = grid(0, 60, 0.02);
+  const auto y = [](double t) { return 0.8 * std::exp(0.5 * t) - 0.4 * std::sin(t) - 0.8 * std::cos(t); };
   for (double t : record.time) {
-    record.signals["y"].push_back(0.8 * std::exp(0.5 * t) - 0.4 * std::sin(t) - 0.8 * std::cos(t));
+    record.signals["y"].push_back(y(std::min(t, 10.0)));
     record.signals["x"].push_back(std::sin(t));
   }
   return record;

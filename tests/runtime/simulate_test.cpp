@@ -445,8 +445,9 @@ TEST(Validate, SolverChosenFromTheEquationsAgreesWithRk4) {
   }
 }
 
-// Fit % and RMS error read the same in small units (a linear model's record scaled by 1e-200),
-// a record beyond the divergence bound (1e8) is said not to be solved rather than given a fit %,
+// Fit % and RMS error read the same in small and large units (a linear model's record scaled by
+// 1e-200 and 1e200), a run beyond the divergence bound (1e8 of the record's size) is said not to be
+// solved rather than given a fit %,
 // and a record reproduced exactly is a fit of 100%, a constant one too (issue 19).
 TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
   const ir::Model m = normalized("input x\noutput y\nparam a, b\ny' + a*y = b*x\n");
@@ -477,10 +478,16 @@ TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
   const auto small = validation_of(1e-200, {2.0, 1.2}).outputs.at(0);
   EXPECT_NEAR(small.fit_percent, one.fit_percent, 0.2);
   EXPECT_NEAR(small.rms_error / 1e-200, one.rms_error, 0.01 * one.rms_error);
+  // Large units as well: the divergence bound (1e8) is of the record's size, not of the number.
   const auto large = validation_of(1e200, {2.0, 1.2});
-  EXPECT_FALSE(large.simulation.completed());
-  EXPECT_FALSE(large.outputs.at(0).follows);
-  EXPECT_FALSE(large.outputs.at(0).fit_percent >= 0) << large.outputs.at(0).fit_percent;  // NaN, not a false 100%
+  EXPECT_TRUE(large.simulation.completed()) << large.simulation.message;
+  EXPECT_NEAR(large.outputs.at(0).fit_percent, small.fit_percent, 1e-9);
+  // A run that does leave the record's size behind by the bound is stopped, in any unit: a
+  // sign error makes y' = 2 y - 1.2 x grow as e^(2t), past 1e8 of the record's size by t = 10.
+  const auto unstable = validation_of(1e200, {-2.0, 1.2});
+  EXPECT_FALSE(unstable.simulation.completed());
+  EXPECT_FALSE(unstable.outputs.at(0).follows);
+  EXPECT_FALSE(unstable.outputs.at(0).fit_percent >= 0) << unstable.outputs.at(0).fit_percent;  // NaN, not a false 100%
   // y' + 2 y = 2 x with x = 1 holds y = 1 exactly: no error, a fit of 100% though y has no spread.
   SampledRecord flat;
   flat.path = "flat.csv";
@@ -492,6 +499,45 @@ TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
   EXPECT_EQ(exact.outputs.at(0).max_abs_error, 0);
   EXPECT_EQ(exact.outputs.at(0).fit_percent, 100);
   EXPECT_TRUE(exact.outputs.at(0).follows);
+}
+
+// The adaptive free run's tolerance is of the signal's size: a Duffing record in micrometres
+// written in metres (y ~ 1e-7) or in picometres (1e-13) is solved as in unit 1, where an absolute
+// tolerance of 1e-9 let the stepper take steps of any length (at 1e-13: fit -2e4%, "departs").
+TEST(Validate, AdaptiveFreeRunIsAsAccurateInAnyUnit) {
+  const ir::Model m = normalized("input x\noutput y\nparam m, c, k, k3\nm*y'' + c*y' + k*y + k3*y^3 = x\n");
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {1.0, 0.4, 4.0, 3.0};
+  o.initial["y"] = {0.2, 0.0};
+  o.time = grid(0, 20, 0.005);
+  o.substeps = 10;
+  for (double t : o.time) o.inputs["x"].push_back(std::sin(1.3 * t) + 0.5 * std::sin(3.1 * t + 1));
+  const auto truth = run(m, f, o);
+  ValidationOptions v;
+  v.method = SimulateOptions::Method::adaptive;
+  auto validation_of = [&](double unit) {
+    SampledRecord record;
+    record.path = "scaled.csv";
+    record.step = 0.005;
+    record.time = o.time;
+    for (std::size_t i = 0; i < o.time.size(); ++i) {
+      record.signals["y"].push_back(unit * truth.outputs[0][i]);
+      record.signals["x"].push_back(unit * o.inputs["x"][i]);
+    }
+    // k3 carries the unit: k3 y^3 must stay the size of x.
+    return std::get<ValidationSummary>(validate(m, f, {1.0, 0.4, 4.0, 3.0 / (unit * unit)}, record, v));
+  };
+  const auto one = validation_of(1);
+  ASSERT_TRUE(one.outputs.at(0).follows);
+  EXPECT_GT(one.outputs.at(0).fit_percent, 99.99);
+  for (double unit : {1e-7, 1e-13, 1e7}) {
+    const auto scaled = validation_of(unit);
+    ASSERT_TRUE(scaled.simulation.completed()) << unit << ": " << scaled.simulation.message;
+    EXPECT_TRUE(scaled.outputs.at(0).follows) << unit;
+    EXPECT_NEAR(scaled.outputs.at(0).fit_percent, one.outputs.at(0).fit_percent, 1e-4) << unit;
+    EXPECT_NEAR(scaled.outputs.at(0).rms_error / unit, one.outputs.at(0).rms_error, 1e-3 * one.outputs.at(0).rms_error + 1e-12) << unit;
+  }
 }
 
 }  // namespace

@@ -47,6 +47,7 @@ struct FitArguments {
   std::string plots;                  // --plots DIR
   std::string report;                 // --report FILE.html
   bool refine = false;                // --refine: output-error refinement after the linear fit
+  bool no_noise_check = false;        // --no-noise-check
   std::string estimator;              // --estimator least_squares|iv, over the model's `set estimator`
   std::optional<double> local;        // --local WIDTH: local fits (thesis chapter V), over `set local`
   std::size_t stride = 1;             // --stride S
@@ -83,6 +84,7 @@ int fit_one(const std::string& compiled_path, const FitArguments& a, const std::
   settings.refine_segments = a.refine_segments;
   settings.initial_state = a.initial_state == "record" ? InitialState::record : InitialState::estimate;
   settings.refine = a.refine;
+  settings.noise_check = !a.no_noise_check;
   settings.estimator = a.estimator;
   settings.local = a.local;
   settings.stride = a.stride;
@@ -214,6 +216,9 @@ void add_fit_command(CLI::App& app, int& exit_status) {
   cmd->add_flag("--refine", a->refine,
                 "Refine the parameters by the output error: Levenberg-Marquardt over the parameters and each record's initial state, "
                 "minimising the difference between the records and the solved equations (as `set refine = simulation`)");
+  cmd->add_flag("--no-noise-check", a->no_noise_check,
+                "Do not refit copies of the records with noise added (the noise check: whether the classical intervals hold and the "
+                "estimates are unbiased under the record's noise; on by default up to 62,500 samples in all)");
   auto* no_validate = cmd->add_flag("--no-validate", a->no_validate, "Do not solve the fitted equations and compare them with the records (thesis section 2-4)");
   cmd->add_option("--validate", a->validate, "Also compare the solved fitted equations with this record, not used in fitting (repeatable)")
       ->allow_extra_args(false)

@@ -173,6 +173,13 @@ Diagnostic instrumental_variables_not_converged(std::string_view statement) {
                  Severity::warning);
 }
 
+Diagnostic noise_biases_estimates(std::string_view statement) {
+  return message("noise-biases-estimates", fmt::format("noise check: {}", statement),
+                 "the report's `noise check` section gives each parameter's scatter and shift; `sidc fit --refine` fits by "
+                 "the simulation error, whose intervals hold under noise",
+                 Severity::warning);
+}
+
 Diagnostic pictures_of_several_models(std::size_t models) {
   return message("pictures-of-several-models", fmt::format("--plots and --report draw one model's fit, and {} models were given", models),
                  "fit the models together for the comparison table, and each alone with --plots or --report");

@@ -73,6 +73,8 @@ Diagnostic pictures_of_several_models(std::size_t models);
 // A warning: the instrumental-variable iteration (`--estimator iv`) did not converge; `statement`
 // says what happened and which estimate is kept (runtime/solve/instrumental_variables.hpp).
 Diagnostic instrumental_variables_not_converged(std::string_view statement);
+// The noise check found intervals too narrow, or estimates biased, under the record's noise.
+Diagnostic noise_biases_estimates(std::string_view statement);
 
 // ---- sidc export -------------------------------------------------------------------------------
 // The fitted model cannot be written as code: `why` says what stands in the way.

@@ -205,6 +205,14 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
                               is_static(model) ? "" : fmt::format(": add --refine to estimate {} with an interval", them)));
   }
 
+  // The noise check (noise_check.hpp): whether the record's noise has biased the estimate beyond its
+  // intervals, for every dynamic model (a static one's regressors are its inputs).
+  if (a.noise_check && !is_static(model)) {
+    run.noise_check = check_noise(model, records, o, summary);
+    out.report("\n" + run.noise_check->report());
+    if (run.noise_check->found_trouble()) out.warning(render(cli_diag::noise_biases_estimates(run.noise_check->statement())));
+  }
+
   // Instrumental variables (instrumental_variables.hpp): a section after the equation-error report;
   // validation solves with its estimate (or the refined one); residual tests and pictures stay
   // those of the equation-error fit.
@@ -314,7 +322,8 @@ FitFiles fit_files_of(const FitRun& run) {
           run.refinement ? &*run.refinement : nullptr,
           run.instrumental_variables ? &*run.instrumental_variables : nullptr,
           run.local ? &*run.local : nullptr,
-          run.nonlinear && run.nonlinear->projection ? &*run.nonlinear->projection : nullptr};
+          run.nonlinear && run.nonlinear->projection ? &*run.nonlinear->projection : nullptr,
+          run.noise_check ? &*run.noise_check : nullptr};
 }
 
 std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory) {

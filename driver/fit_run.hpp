@@ -31,6 +31,7 @@
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/instrumental_variables.hpp"
 #include "runtime/solve/local_fit.hpp"
+#include "runtime/solve/noise_check.hpp"
 #include "runtime/solve/residual_analysis.hpp"
 #include "runtime/solve/variable_projection.hpp"
 
@@ -47,6 +48,7 @@ struct FitSettings {
   int refine_segments = 0;                     // shooting segments per record (RefineOptions::segments; 0 = chosen)
   InitialState initial_state = InitialState::estimate;
   bool refine = false;
+  bool noise_check = true;                     // the noise check (noise_check.hpp) after the fit's report
   std::string estimator;                      // "", least_squares or iv: over the model's `set estimator`
   std::string no_validate_name = "--no-validate";  // how the face names that option in the report
   // Local fits (runtime/solve/local_fit.hpp, thesis chapter V): windows of `local` (time; over the
@@ -97,6 +99,7 @@ struct FitRun {
   LoadedRecords loaded;
   std::optional<FormChoice> form_choice;
   FitSummary summary;
+  std::optional<NoiseCheck> noise_check;
   std::optional<InstrumentalVariablesSummary> instrumental_variables;
   std::optional<RefineSummary> refinement;
   std::optional<FitValidation> validation;

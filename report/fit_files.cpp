@@ -270,6 +270,16 @@ nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSu
           {"groups", std::move(groups)}};
 }
 
+nlohmann::ordered_json noise_check_json(const NoiseCheck& check) {
+  using nlohmann::ordered_json;
+  if (!check.ran) return {{"ran", false}, {"statement", check.statement()}};
+  ordered_json parameters = ordered_json::array();
+  for (const auto& s : check.shifts)
+    parameters.push_back({{"name", s.name}, {"estimate", s.estimate}, {"standard_error", s.standard_error}, {"copies_sd", s.scatter},
+                          {"shift", s.shift}, {"shift_error", s.shift_error}, {"too_narrow", s.narrow}, {"biased", s.biased}});
+  return {{"ran", true}, {"replicates", check.replicates}, {"statement", check.statement()}, {"parameters", std::move(parameters)}};
+}
+
 nlohmann::ordered_json validation_json(const FitValidation& v, std::size_t fitted_records) {
   using nlohmann::ordered_json;
   ordered_json j;
@@ -408,6 +418,7 @@ nlohmann::ordered_json fit_document(const FitFiles& f) {
   json["form_choice"] = std::move(choice);
   json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
   json["instrumental_variables"] = f.instrumental_variables ? instrumental_variables_json(*f.instrumental_variables) : nlohmann::ordered_json(nullptr);
+  json["noise_check"] = f.noise_check ? noise_check_json(*f.noise_check) : nlohmann::ordered_json(nullptr);
   json["local"] = f.local ? local_json(*f.local) : nlohmann::ordered_json(nullptr);
   json["nonlinear_parameters"] = f.nonlinear ? nonlinear_json(*f.nonlinear) : nlohmann::ordered_json(nullptr);
   non_finite_as_strings(json);

@@ -21,6 +21,7 @@
 #include "runtime/refine/refine.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/instrumental_variables.hpp"
+#include "runtime/solve/noise_check.hpp"
 #include "runtime/solve/local_fit.hpp"
 #include "runtime/solve/variable_projection.hpp"
 #include "runtime/solve/residual_analysis.hpp"
@@ -32,6 +33,7 @@ nlohmann::ordered_json fit_json(const FitSummary& summary, const CompiledModel& 
 nlohmann::ordered_json validation_json(const FitValidation& validation, std::size_t fitted_records);
 nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis);
 nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSummary& iv);
+nlohmann::ordered_json noise_check_json(const NoiseCheck& check);
 // record,t, then per output: recorded, simulated, error; "" when nothing was simulated.
 std::string validation_csv(const FitValidation& validation);
 
@@ -65,6 +67,9 @@ struct FitFiles {
   // `sin(L*theta)`; variable_projection.hpp); null when the model has none (fit.json's
   // `nonlinear_parameters` is then null).
   const VariableProjectionSummary* nonlinear = nullptr;
+  // The noise check (noise_check.hpp); null when it was switched off or the model is static
+  // (fit.json's `noise_check` is then null).
+  const NoiseCheck* noise_check = nullptr;
 };
 
 // local.csv: one row per window (record, when several, then t_center, each parameter and its

@@ -434,13 +434,19 @@ std::optional<Diagnostic> fit_weak_group(const ir::Model& model, const std::vect
                                          const std::vector<OperatorReport>& operators, GroupFit& g) {
   auto expression = expression_weights_by_record(model, evaluators);
   if (auto* d = std::get_if<Diagnostic>(&expression)) return *d;
-  auto made = weak_design(model, records, evaluators, design, g.equations, std::get<std::vector<std::vector<double>>>(expression), options.share);
+  const std::vector<TestFunctionGrid>* given = nullptr;
+  if (options.same_choices_as)
+    for (const auto& other : options.same_choices_as->groups)
+      if (other.equations == g.equations && other.weak_grids.size() == records.size()) given = &other.weak_grids;
+  auto made = weak_design(model, records, evaluators, design, g.equations, std::get<std::vector<std::vector<double>>>(expression), options.share,
+                          given);
   if (auto* d = std::get_if<Diagnostic>(&made)) return *d;
   WeakDesign& w = std::get<WeakDesign>(made);
   for (std::size_t r = 0; r < records.size(); ++r) {
     g.records[r].rows = w.grids[r].centres.size();
     g.subdomains.push_back(describe(w.grids[r], records[r].step));
   }
+  g.weak_grids = w.grids;
   g.row_equation = std::move(w.row_equation);
   g.row_record = std::move(w.row_record);
   g.row_time = std::move(w.row_time);
@@ -523,9 +529,14 @@ std::variant<FitSummary, Diagnostic> fit(const ir::Model& model, const std::vect
   std::vector<FitWindow> windows;
   std::vector<EvaluationOptions> evaluation;  // per record: under savgol(auto), its own arcs
   for (const auto& r : records) {
-    auto chosen = choose_operators(r, model, options.evaluation);
-    if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
-    summary.operators.push_back(std::get<OperatorReport>(std::move(chosen)));
+    if (const FitSummary* given = options.same_choices_as) {
+      if (given->operators.size() != records.size()) throw std::logic_error("fit: the choices given are of other records");
+      summary.operators.push_back(given->operators[summary.operators.size()]);
+    } else {
+      auto chosen = choose_operators(r, model, options.evaluation);
+      if (auto* d = std::get_if<Diagnostic>(&chosen)) return *d;
+      summary.operators.push_back(std::get<OperatorReport>(std::move(chosen)));
+    }
     evaluation.push_back(with_arcs(options.evaluation, summary.operators.back()));
     auto w = fit_window(r, model, evaluation.back(), options.from, options.to);
     if (auto* d = std::get_if<Diagnostic>(&w)) return *d;

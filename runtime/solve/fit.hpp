@@ -27,6 +27,7 @@
 #include "ir/ir.hpp"
 #include "runtime/operators/evaluate.hpp"
 #include "runtime/operators/operator_choice.hpp"
+#include "runtime/operators/test_functions.hpp"
 #include "runtime/solve/design.hpp"
 #include "runtime/solve/drift_check.hpp"
 #include "runtime/solve/hac_covariance.hpp"
@@ -35,6 +36,8 @@
 #include "runtime/solve/weak_covariance.hpp"
 
 namespace sidc {
+
+struct FitSummary;
 
 struct FitOptions {
   EvaluationOptions evaluation;
@@ -64,6 +67,10 @@ struct FitOptions {
   // fitted whole by each, and so is a group with more than 16 guards (2^guards region counts).
   RowShare* share = nullptr;
   bool weak_covariance = true;
+  // Optional, not owned: a fit of the same model to records of the same shape whose data-driven
+  // choices (noise levels and arcs per record, weak subdomains per group) this fit takes instead of
+  // making its own, so that it differs from that one by the data alone (noise_check.hpp).
+  const FitSummary* same_choices_as = nullptr;
   std::string weak_covariance_off = "set weak_weighting = none";  // why not, for the report, when false
   bool is_valid(std::string* why) const;
 };
@@ -107,6 +114,7 @@ struct GroupFit {
   std::string streamed;
   // Weak-form groups (weak_design.hpp): per record, its subdomains and how their width was chosen.
   std::vector<std::string> subdomains;
+  std::vector<TestFunctionGrid> weak_grids;  // the same, per record, as chosen
   WeakWeighting weak_weighting;  // weak-form groups: how their rows were weighted
   // CPU seconds (all threads) spent evaluating operations and folding rows (streamed fits), and
   // wall seconds of the final p x p solve, for the bench.

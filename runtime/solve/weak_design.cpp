@@ -210,10 +210,12 @@ std::optional<Diagnostic> WeakValues::evaluate(const ir::Sum& sum, std::size_t, 
 std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, const std::vector<SampledRecord>& records, std::size_t r,
                                                         Evaluator& evaluator, const DesignBuilder& design,
                                                         const std::vector<std::size_t>& equations, std::span<const double> expression,
-                                                        RowShare* share) {
+                                                        RowShare* share, const TestFunctionGrid* given) {
   WeakDesign out;
   std::variant<TestFunctionGrid, Diagnostic> chosen = Diagnostic{};
-  {
+  if (given) {
+    chosen = *given;
+  } else {
     // The outputs on the window, read where the record holds them (a copy is 80 MB each at 10^7
     // samples); an output the record lacks, or with a value that is not finite, is evaluated for
     // the evaluator's message.
@@ -283,12 +285,14 @@ std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, 
 std::variant<WeakDesign, Diagnostic> weak_design(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                  std::vector<Evaluator>& evaluators, const DesignBuilder& design,
                                                  const std::vector<std::size_t>& equations,
-                                                 const std::vector<std::vector<double>>& expression_weights, RowShare* share) {
+                                                 const std::vector<std::vector<double>>& expression_weights, RowShare* share,
+                                                 const std::vector<TestFunctionGrid>* given) {
   std::vector<WeakDesign> parts;
   Eigen::Index total = 0;
   for (std::size_t r = 0; r < records.size(); ++r) {
     const std::span<const double> expression = r < expression_weights.size() ? std::span<const double>(expression_weights[r]) : std::span<const double>();
-    auto part = weak_record_design(model, records, r, evaluators[r], design, equations, expression, share);
+    auto part = weak_record_design(model, records, r, evaluators[r], design, equations, expression, share,
+                                   given && r < given->size() ? &(*given)[r] : nullptr);
     if (auto* d = std::get_if<Diagnostic>(&part)) return *d;
     parts.push_back(std::get<WeakDesign>(std::move(part)));
     total += parts.back().b.size();

@@ -77,17 +77,20 @@ struct WeakDesign {
 
 // The weak design of `design`'s group on record `r` alone (its evaluator on its window):
 // `expression` is `set weights` on the window as fit.cpp computes it (empty when the model sets none).
+// Its subdomains are chosen from the record (choose_test_functions), or `given` (a fit made again on
+// changed data with the first one's choices: noise_check.hpp).
 std::variant<WeakDesign, Diagnostic> weak_record_design(const ir::Model& model, const std::vector<SampledRecord>& records, std::size_t r,
                                                         Evaluator& evaluator, const DesignBuilder& design,
                                                         const std::vector<std::size_t>& equations, std::span<const double> expression,
-                                                        RowShare* share = nullptr);
+                                                        RowShare* share = nullptr, const TestFunctionGrid* given = nullptr);
 
 // The weak design of `design`'s group over every record (each evaluator on its record's window),
 // the records' rows stacked; `expression_weights` per record (empty when the model sets none).
 std::variant<WeakDesign, Diagnostic> weak_design(const ir::Model& model, const std::vector<SampledRecord>& records,
                                                  std::vector<Evaluator>& evaluators, const DesignBuilder& design,
                                                  const std::vector<std::size_t>& equations,
-                                                 const std::vector<std::vector<double>>& expression_weights, RowShare* share = nullptr);
+                                                 const std::vector<std::vector<double>>& expression_weights, RowShare* share = nullptr,
+                                                 const std::vector<TestFunctionGrid>* given = nullptr);
 
 // One line for the report: "42 subdomains of 2*48+1 samples, phi = (1 - s^2)^6; <reason>".
 std::string describe(const TestFunctionGrid& grid, double step);

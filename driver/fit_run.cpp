@@ -205,8 +205,9 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
                               is_static(model) ? "" : fmt::format(": add --refine to estimate {} with an interval", them)));
   }
 
-  // The noise check (noise_check.hpp): whether the record's noise has biased the estimate beyond its
-  // intervals, for every dynamic model (a static one's regressors are its inputs).
+  // The noise check (noise_check.hpp): whether the classical intervals hold under the record's noise
+  // and whether it biased the estimate, for every dynamic model (a static one's regressors are its
+  // inputs, taken as exact).
   if (a.noise_check && !is_static(model)) {
     run.noise_check = check_noise(model, records, o, summary);
     out.report("\n" + run.noise_check->report());

@@ -7,6 +7,7 @@
 #include <memory>
 #include <fmt/format.h>
 
+#include "diagnostics/time_text.hpp"
 #include "runtime/operators/noise_level.hpp"
 #include "runtime/simulate/initial_state.hpp"
 #include "runtime/solve/fitted_values.hpp"
@@ -417,12 +418,12 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     // its largest error.
     std::string parts, short_of;
     for (const auto& r : v.outputs) {
-      const std::string numbers = fmt::format("max |E[{}]| = {:.4g} at t = {:.4g} ({:.3g}% of max |{}|, eq. 4-1.5)", r.output, r.max_abs_error,
-                                              r.time_of_max, r.percent_error, r.output);
+      const std::string numbers = fmt::format("max |E[{}]| = {:.4g} at t = {} ({:.3g}% of max |{}|, eq. 4-1.5)", r.output, r.max_abs_error,
+                                              time_text(r.time_of_max, record.step, 4), r.percent_error, r.output);
       parts += (parts.empty() ? "" : "; ") + numbers;
       if (r.follows) continue;
       const std::string departs =
-          r.departs_at ? fmt::format("departs at t = {:.4g} (local RMS error above {:g}% of the standard deviation of {}), ", *r.departs_at,
+          r.departs_at ? fmt::format("departs at t = {} (local RMS error above {:g}% of the standard deviation of {}), ", time_text(*r.departs_at, record.step, 4),
                                      100 * kDepartureShare, r.output)
                        : std::string();
       short_of += fmt::format("{}fit {:.3g}% for {} (below {:g}%), {}{}", short_of.empty() ? "" : "; ", r.fit_percent, r.output, kFollowsFitPercent,
@@ -430,16 +431,16 @@ std::variant<ValidationSummary, Diagnostic> validate(const ir::Model& normalized
     }
     v.statement = short_of.empty() ? "The fitted equations, solved from the record, follow it: " + parts + "."
                                    : "The fitted equations, solved from the record, do not follow it: " + short_of + ".";
-    if (v.restarted && v.restarted->sensitive) v.statement = v.restarted->statement(short_of);
+    if (v.restarted && v.restarted->sensitive) v.statement = v.restarted->statement(short_of, record.step);
   } else {
     v.statement = fmt::format("The fitted equations could not be solved over the whole record: {}. The model does not reproduce the record; "
-                              "the numbers below cover the samples before t = {:.6g}.",
-                              v.simulation.message, v.simulation.stopped_at.value_or(record.time.front()));
+                              "the numbers below cover the samples before t = {}.",
+                              v.simulation.message, time_text(v.simulation.stopped_at.value_or(record.time.front()), record.step, 6));
   }
   return v;
 }
 
-std::string ValidationSummary::Restarted::statement(const std::string& free_run) const {
+std::string ValidationSummary::Restarted::statement(const std::string& free_run, double step) const {
   std::string fits;
   for (const auto& [output, fit] : fit_percent)
     fits += fmt::format("{}fit {:.4g}% for {}{}", fits.empty() ? "" : ", ", fit, output, fit >= kFollowsFitPercent ? "" : fmt::format(" (below {:g}%)", kFollowsFitPercent));
@@ -447,8 +448,8 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
       separates_at.value_or(start) <= start
           ? "the initial state estimated over the start segment is itself uncertain by more than a tenth of an output's spread"
           : fmt::format("started one standard deviation of the estimated initial state away (for the record's noise), their own solution "
-                        "separates from this one by t = {:.4g}",
-                        separates_at.value_or(start));
+                        "separates from this one by t = {}",
+                        time_text(separates_at.value_or(start), step, 4));
   const std::string runs_text = fmt::format("restarted from the record every {:.4g} time units ({} runs{}, each from a state estimated over its start "
                                             "and compared up to where its own displaced runs separate from it: {:.3g}% of their samples)",
                                             run_every, runs, run_every > run_duration ? fmt::format(" of {:.4g}", run_duration) : "",
@@ -469,8 +470,8 @@ std::string ValidationSummary::Restarted::statement(const std::string& free_run)
                                                          "follow it for longer (a chaotic or unstable solution)",
                                                          twin);
     return fmt::format("The fitted equations follow the record within their horizon of predictability: {}, {}. Solved freely over the whole record "
-                       "they depart at t = {:.4g}, {}. The free run: {}.",
-                       runs_text, fits, free_run_departs_at, why, free_run);
+                       "they depart at t = {}, {}. The free run: {}.",
+                       runs_text, fits, time_text(free_run_departs_at, step, 4), why, free_run);
   }
   return fmt::format("The fitted equations, solved from the record, do not follow it: {}. Nor when {}, within the horizon their own "
                      "sensitivity to the initial state allows ({}): {}{}.",
@@ -485,16 +486,18 @@ std::string ValidationSummary::report(const std::string& method) const {
   };
   std::string out = fmt::format("validation (thesis section 2-4): the fitted equations solved by {} against `{}`,\n", method, record);
   const double first = simulation.time.empty() ? 0.0 : simulation.time.front();
+  const double step = simulation.time.size() > 1 ? simulation.time[1] - simulation.time[0] : 0.0;
   if (initial_method == InitialState::estimate && start_segment > 0)
-    out += fmt::format("  from t = {:.6g} with {} (estimated by least squares over the first {} samples, to t = {:.6g}, {} step{};\n"
+    out += fmt::format("  from t = {} with {} (estimated by least squares over the first {} samples, to t = {}, {} step{};\n"
                        "  the record gives {}: sample and moving-arc derivatives)\n",
-                       first, listed(initial_state), start_segment, simulation.time.size() >= start_segment ? simulation.time[start_segment - 1] : first,
-                       estimate_iterations, estimate_iterations == 1 ? "" : "s", listed(recorded_state));
+                       time_text(first, step, 6), listed(initial_state), start_segment,
+                       time_text(simulation.time.size() >= start_segment ? simulation.time[start_segment - 1] : first, step, 6), estimate_iterations,
+                       estimate_iterations == 1 ? "" : "s", listed(recorded_state));
   else
-    out += fmt::format("  from t = {:.6g} with {} (taken from the record; derivatives by the moving arc)\n", first, listed(initial_state));
+    out += fmt::format("  from t = {} with {} (taken from the record; derivatives by the moving arc)\n", time_text(first, step, 6), listed(initial_state));
   out += fmt::format("  {:<10} {:>8} {:>12} {:>10} {:>16} {:>10} {:>12}\n", "output", "samples", "max |E|", "at t", "%E (eq. 4-1.5)", "fit %", "RMS E");
   for (const auto& r : outputs)
-    out += fmt::format("  {:<10} {:>8} {:>12.4g} {:>10.4g} {:>16.3g} {:>10.4g} {:>12.4g}\n", r.output, r.samples, r.max_abs_error, r.time_of_max,
+    out += fmt::format("  {:<10} {:>8} {:>12.4g} {:>10} {:>16.3g} {:>10.4g} {:>12.4g}\n", r.output, r.samples, r.max_abs_error, time_text(r.time_of_max, step, 4),
                        r.percent_error, r.fit_percent, r.rms_error);
   out += "  " + statement + "\n";
   return out;

@@ -163,7 +163,7 @@ struct ValidationSummary {
     bool completed = true;           // every restarted run reached its end
     bool follows = false;            // judged, completed and every output at kFollowsFitPercent or more
     // The verdict's sentence, given the free run's shortfall as validate() words it.
-    std::string statement(const std::string& free_run) const;
+    std::string statement(const std::string& free_run, double step) const;  // step: the record's, for printing times
   };
   std::optional<Restarted> restarted;
   std::string statement;  // one plain sentence: how well, or where it diverged

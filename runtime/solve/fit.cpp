@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "diagnostics/model_catalogue.hpp"
+#include "diagnostics/time_text.hpp"
 #include "ir/print.hpp"
 #include "ir/queries.hpp"
 #include "ir/traversal.hpp"
@@ -795,7 +796,8 @@ std::string FitSummary::full_report(const ir::Model& model) const {
       if (is_static(model))
         out += fmt::format("  record {}: rows {} to {}, n = {} per equation\n", r.path, r.first_sample + 1, r.first_sample + r.rows, r.rows);
       else
-        out += fmt::format("  record {}: t0 = {:g} to {:g}, step {:g}, n = {} per equation\n", r.path, r.t0, r.t_last, r.step, r.rows);
+        out += fmt::format("  record {}: t0 = {} to {}, step {:g}, n = {} per equation\n", r.path, time_text(r.t0, r.step, 6), time_text(r.t_last, r.step, 6),
+                           r.step, r.rows);
     }
     if (!g.regions.empty()) {
       out += "  rows by region (Table 4-1.1):\n";

@@ -67,11 +67,11 @@ struct FitOptions {
   // fitted whole by each, and so is a group with more than 16 guards (2^guards region counts).
   RowShare* share = nullptr;
   bool weak_covariance = true;
+  std::string weak_covariance_off = "set weak_weighting = none";  // why not, for the report, when false
   // Optional, not owned: a fit of the same model to records of the same shape whose data-driven
   // choices (noise levels and arcs per record, weak subdomains per group) this fit takes instead of
   // making its own, so that it differs from that one by the data alone (noise_check.hpp).
   const FitSummary* same_choices_as = nullptr;
-  std::string weak_covariance_off = "set weak_weighting = none";  // why not, for the report, when false
   bool is_valid(std::string* why) const;
 };
 

@@ -18,6 +18,8 @@
 #include <boost/property_tree/xml_parser.hpp>
 #include <gtest/gtest.h>
 
+#include "diagnostics/time_text.hpp"
+
 #include "report/fit_figures.hpp"
 #include "report/gnuplot_renderer.hpp"
 #include "report/html_report.hpp"
@@ -406,4 +408,18 @@ TEST(HtmlReport, RefusesToEmbedAnSvgThatReachesOutside) {
 }
 
 }  // namespace
+
+// Times print with the digits that tell samples apart: a record stamped in Unix seconds would
+// otherwise print every sample and event as 1.733e+09.
+TEST(TimeText, KeepsTheDigitsTheStepNeeds) {
+  EXPECT_EQ(time_text(8.6, 0.01, 4), "8.6");        // as {:.4g}: ordinary records print as before
+  EXPECT_EQ(time_text(49.1234, 0.01, 4), "49.12");
+  EXPECT_EQ(time_text(0.0, 0.01, 4), "0");
+  EXPECT_EQ(time_text(1732780829.99, 0.01, 4), "1732780829.99");
+  EXPECT_EQ(time_text(1732780800.0, 0.01, 6), "1732780800");
+  EXPECT_EQ(time_text(12345.67, 0.01, 4), "12345.67");
+  EXPECT_EQ(time_text(2.5e6, 0.0, 4), "2.5e+06");    // no step: as before
+  EXPECT_EQ(time_text(NAN, 0.01, 4), "nan");
+}
+
 }  // namespace sidc

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "diagnostics/time_text.hpp"
 #include "compiler/explicit_form_pass.hpp"
 #include "support/simulation.hpp"
 #include "compiler/pipeline.hpp"
@@ -499,6 +501,38 @@ TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
   EXPECT_EQ(exact.outputs.at(0).max_abs_error, 0);
   EXPECT_EQ(exact.outputs.at(0).fit_percent, 100);
   EXPECT_TRUE(exact.outputs.at(0).follows);
+}
+
+// A record stamped in Unix seconds is validated as one stamped from 0, and its report tells its
+// samples apart (it printed every time as 1.733e+09).
+TEST(Validate, EpochStampedRecordPrintsTimesItsStepTellsApart) {
+  const ir::Model m = normalized("input x\noutput y\nparam a, b\ny' + a*y = b*x\n");
+  const ExplicitForm f = form_of(m);
+  SimulateOptions o;
+  o.parameters = {2.0, 1.0};
+  o.initial["y"] = {0.3};
+  o.time = grid(0, 10, 0.01);
+  o.substeps = 10;
+  for (double t : o.time) o.inputs["x"].push_back(std::sin(t));
+  const auto truth = run(m, f, o);
+  auto record_from = [&](double t0) {
+    SampledRecord record;
+    record.path = "stamped.csv";
+    record.step = 0.01;
+    for (double t : o.time) record.time.owned().push_back(t0 + t);
+    record.signals["y"] = truth.outputs[0];
+    record.signals["x"] = o.inputs["x"];
+    return record;
+  };
+  ValidationOptions v;
+  const auto from_zero = std::get<ValidationSummary>(validate(m, f, {2.0, 1.2}, record_from(0), v));
+  const auto stamped = std::get<ValidationSummary>(validate(m, f, {2.0, 1.2}, record_from(1732780800.0), v));
+  EXPECT_NEAR(stamped.outputs.at(0).fit_percent, from_zero.outputs.at(0).fit_percent, 1e-3);
+  EXPECT_NEAR(stamped.outputs.at(0).time_of_max - 1732780800.0, from_zero.outputs.at(0).time_of_max, 1e-6);
+  const std::string report = stamped.report("RK4");
+  EXPECT_EQ(report.find("e+09"), std::string::npos) << report;
+  EXPECT_NE(report.find(fmt::format("at t = {}", time_text(stamped.outputs.at(0).time_of_max, 0.01, 4))), std::string::npos) << report;
+  EXPECT_NE(report.find("from t = 17327808"), std::string::npos) << report;
 }
 
 // The adaptive free run's tolerance is of the signal's size: a Duffing record in micrometres

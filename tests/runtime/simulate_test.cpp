@@ -447,20 +447,37 @@ TEST(Validate, SolverChosenFromTheEquationsAgreesWithRk4) {
   }
 }
 
+// y' + a y = b x with a = 2, b = 1, x = sin t, from y = 0.3 on [0, 10] every 0.01 (RK4, 10 steps per
+// sample): the record the validation tests below scale, shift and fit wrongly.
+struct FirstOrderTruth {
+  ir::Model m;
+  ExplicitForm f;
+  SimulateOptions o;
+  SimulationSummary truth;
+};
+
+FirstOrderTruth first_order_truth() {
+  FirstOrderTruth out{normalized("input x\noutput y\nparam a, b\ny' + a*y = b*x\n"), {}, {}, {}};
+  out.f = form_of(out.m);
+  out.o.parameters = {2.0, 1.0};
+  out.o.initial["y"] = {0.3};
+  out.o.time = grid(0, 10, 0.01);
+  out.o.substeps = 10;
+  for (double t : out.o.time) out.o.inputs["x"].push_back(std::sin(t));
+  out.truth = run(out.m, out.f, out.o);
+  return out;
+}
+
 // Fit % and RMS error read the same in small and large units (a linear model's record scaled by
 // 1e-200 and 1e200), a run beyond the divergence bound (1e8 of the record's size) is said not to be
 // solved rather than given a fit %,
 // and a record reproduced exactly is a fit of 100%, a constant one too (issue 19).
 TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
-  const ir::Model m = normalized("input x\noutput y\nparam a, b\ny' + a*y = b*x\n");
-  const ExplicitForm f = form_of(m);
-  SimulateOptions o;
-  o.parameters = {2.0, 1.0};
-  o.initial["y"] = {0.3};
-  o.time = grid(0, 10, 0.01);
-  o.substeps = 10;
-  for (double t : o.time) o.inputs["x"].push_back(std::sin(t));
-  const auto truth = run(m, f, o);
+  const FirstOrderTruth first = first_order_truth();
+  const ir::Model& m = first.m;
+  const ExplicitForm& f = first.f;
+  const SimulateOptions& o = first.o;
+  const SimulationSummary& truth = first.truth;
   ValidationOptions v;
   auto validation_of = [&](double unit, const std::vector<double>& parameters) {
     SampledRecord record;
@@ -469,7 +486,7 @@ TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
     record.time = o.time;
     for (std::size_t i = 0; i < o.time.size(); ++i) {
       record.signals["y"].push_back(unit * truth.outputs[0][i]);
-      record.signals["x"].push_back(unit * o.inputs["x"][i]);
+      record.signals["x"].push_back(unit * o.inputs.at("x")[i]);
     }
     return std::get<ValidationSummary>(validate(m, f, parameters, record, v));
   };
@@ -506,27 +523,24 @@ TEST(Validate, FitPercentIsTheSameInAnyUnitAndExactIsAHundred) {
 // A record stamped in Unix seconds is validated as one stamped from 0, and its report tells its
 // samples apart (it printed every time as 1.733e+09).
 TEST(Validate, EpochStampedRecordPrintsTimesItsStepTellsApart) {
-  const ir::Model m = normalized("input x\noutput y\nparam a, b\ny' + a*y = b*x\n");
-  const ExplicitForm f = form_of(m);
-  SimulateOptions o;
-  o.parameters = {2.0, 1.0};
-  o.initial["y"] = {0.3};
-  o.time = grid(0, 10, 0.01);
-  o.substeps = 10;
-  for (double t : o.time) o.inputs["x"].push_back(std::sin(t));
-  const auto truth = run(m, f, o);
+  const FirstOrderTruth first = first_order_truth();
+  const ir::Model& m = first.m;
+  const ExplicitForm& f = first.f;
+  const SimulateOptions& o = first.o;
+  const SimulationSummary& truth = first.truth;
   auto record_from = [&](double t0) {
     SampledRecord record;
     record.path = "stamped.csv";
     record.step = 0.01;
     for (double t : o.time) record.time.owned().push_back(t0 + t);
     record.signals["y"] = truth.outputs[0];
-    record.signals["x"] = o.inputs["x"];
+    record.signals["x"] = o.inputs.at("x");
     return record;
   };
   ValidationOptions v;
-  const auto from_zero = std::get<ValidationSummary>(validate(m, f, {2.0, 1.2}, record_from(0), v));
-  const auto stamped = std::get<ValidationSummary>(validate(m, f, {2.0, 1.2}, record_from(1732780800.0), v));
+  const SampledRecord zero_record = record_from(0), stamped_record = record_from(1732780800.0);  // the summaries borrow their samples
+  const auto from_zero = std::get<ValidationSummary>(validate(m, f, {2.0, 1.2}, zero_record, v));
+  const auto stamped = std::get<ValidationSummary>(validate(m, f, {2.0, 1.2}, stamped_record, v));
   EXPECT_NEAR(stamped.outputs.at(0).fit_percent, from_zero.outputs.at(0).fit_percent, 1e-3);
   EXPECT_NEAR(stamped.outputs.at(0).time_of_max - 1732780800.0, from_zero.outputs.at(0).time_of_max, 1e-6);
   const std::string report = stamped.report("RK4");

@@ -309,7 +309,7 @@ using FitHandle = std::shared_ptr<FitSession>;  // never changed after the fit
 
 FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& kwargs) {
   const Keywords k("fit", kwargs, with_record_keywords({"integrate", "form", "no_validate", "validate", "validate_samples", "refine_samples", "refine_segments", "initial_state",
-                                                         "refine", "estimator", "local", "stride", "forget"}));
+                                                         "refine", "no_noise_check", "estimator", "local", "stride", "forget"}));
   driver::FitSettings s;
   s.records = record_settings(k);
   std::string integrate, form, initial_state;
@@ -324,6 +324,9 @@ FitHandle run_fit(const ModelHandle& m, const py::object& data, const py::dict& 
   k.text("initial_state", initial_state, {"estimate", "record"});
   if (initial_state == "record") s.initial_state = InitialState::record;
   k.flag("refine", s.refine);
+  bool no_noise_check = false;
+  k.flag("no_noise_check", no_noise_check);
+  s.noise_check = !no_noise_check;
   k.text("estimator", s.estimator, {"least_squares", "iv"});
   k.number("local", s.local, true);
   k.integer("stride", s.stride, 1);

@@ -139,6 +139,14 @@ class FitAgreesWithCli(Workspace):
         self.assertEqual(model.fit(read_record(self.csv), **{"from": 0.1}, no_validate=True).estimates,
                          model.fit(read_record(self.csv), from_=0.1, no_validate=True).estimates)
 
+    def test_noise_check_is_the_clis(self):
+        cli = json.loads(self.cli_fit("--no-validate"))
+        model = sidc.compile(self.model_path)
+        checked = json.loads(model.fit(read_record(self.csv), no_validate=True).to_json())["noise_check"]
+        self.assertEqual(cli["noise_check"], checked)
+        self.assertIn("parameters", checked)
+        self.assertIsNone(json.loads(model.fit(read_record(self.csv), no_validate=True, no_noise_check=True).to_json())["noise_check"])
+
     def test_several_records(self):
         half = os.path.join(self.dir, "second.csv")
         record = read_record(self.csv)

@@ -17,21 +17,19 @@ std::string listed(const std::vector<std::string>& names) {
   return out;
 }
 
+// The names of the shifts whose `flag` is set.
+std::vector<std::string> flagged(const std::vector<NoiseCheck::Shift>& shifts, bool NoiseCheck::Shift::*flag) {
+  std::vector<std::string> out;
+  for (const auto& s : shifts)
+    if (s.*flag) out.push_back(s.name);
+  return out;
+}
+
 }  // namespace
 
-std::vector<std::string> NoiseCheck::narrow() const {
-  std::vector<std::string> out;
-  for (const auto& s : shifts)
-    if (s.narrow) out.push_back(s.name);
-  return out;
-}
+std::vector<std::string> NoiseCheck::narrow() const { return flagged(shifts, &Shift::narrow); }
 
-std::vector<std::string> NoiseCheck::biased() const {
-  std::vector<std::string> out;
-  for (const auto& s : shifts)
-    if (s.biased) out.push_back(s.name);
-  return out;
-}
+std::vector<std::string> NoiseCheck::biased() const { return flagged(shifts, &Shift::biased); }
 
 std::string NoiseCheck::statement() const {
   if (!ran) return "not run: " + not_run;

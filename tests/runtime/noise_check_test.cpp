@@ -18,7 +18,6 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -44,7 +43,8 @@ CompileResult compiled(const std::string& text) {
 FitOptions options_of(const CompileResult& c) { return fit_options(evaluation_settings(c.integrated->settings)); }
 
 // `truth` (an input x defined by t, one output y) solved from `initial` on `time` by RK4 with 20
-// steps per sample, and `share` of y's s.d. of Gaussian noise added; x recorded beside it.
+// steps per sample, and `share` of y's s.d. of Gaussian noise added (testing::simulated_record); x
+// recorded beside it.
 SampledRecord record_of(const std::string& truth_text, std::vector<double> parameters, std::vector<double> initial, const Column& time,
                         const std::function<double(double)>& input, double share, unsigned seed) {
   const CompileResult truth = compiled(truth_text);
@@ -53,16 +53,7 @@ SampledRecord record_of(const std::string& truth_text, std::vector<double> param
   o.initial["y"] = std::move(initial);
   o.time = time;
   o.substeps = 20;
-  auto run = simulate(*truth.normalized, form_of(*truth.normalized), o);
-  EXPECT_TRUE(std::holds_alternative<SimulationSummary>(run));
-  std::vector<double> y = std::get<SimulationSummary>(run).outputs[0];
-  std::mt19937 engine(seed);
-  testing::add_noise(y, share, engine);
-  SampledRecord record;
-  record.path = "record.csv";
-  record.step = time[1] - time[0];
-  record.time = time;
-  record.signals["y"] = std::move(y);
+  SampledRecord record = testing::simulated_record(*truth.normalized, form_of(*truth.normalized), o, "record.csv", share, seed);
   for (double t : time) record.signals["x"].push_back(input(t));
   return record;
 }

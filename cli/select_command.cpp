@@ -113,7 +113,7 @@ int run_select(const SelectArguments& a) {
   // Every rank has selected, or the job stops here without a file written.
   if (!session.agree(exit_code::success)) return fail(render(diag::error("stopped", {}, session.who_left())), exit_code::user_error);
   if (!a.out.empty() && session.is_writer()) {
-    auto written = write_select_file(a.out, *run.summary, a.model, run.options);
+    auto written = write_select_file(a.out, *run.summary, a.model, run.options, run.settings.records.keep_outliers ? nullptr : &run.loaded.outliers);
     if (auto* d = std::get_if<Diagnostic>(&written)) return fail(render(*d), exit_code::user_error);
     std::cerr << "wrote " << std::get<std::string>(written) << "\n";
   }

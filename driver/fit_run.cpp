@@ -182,7 +182,11 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   for (const auto& g : summary.groups)
     for (const auto& w : drift_warnings(model, g.drift)) out.warning(render(w));
   for (const auto& w : statistics_warnings(model, summary)) out.warning(render(w));
+  const std::string& keep = a.records.keep_outliers_name;
+  for (const auto& scan : run.loaded.outliers) out.warning(outlier_warning(scan, "sidc fit", keep));
+  const std::string outliers = outlier_report(run.loaded.outliers, keep);
   std::string report = fmt::format("sidc fit: model `{}` ({})\n{}\n", model.name, run.model_path, a.processes.empty() ? "" : a.processes + "\n") + form_report + (form_report.empty() ? "" : "\n") +
+                       outliers + (outliers.empty() ? "" : "\n") +
                        operator_report(summary.operators, o.evaluation, model);
   if (!is_static(model)) report += "\n";
   out.report(report + summary.full_report(model));
@@ -262,7 +266,11 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     // The fitted records, then those given only to be compared with (not copied: records can be long).
     std::vector<SampledRecord>& extra = run.validated_only;
     for (auto& input : run.settings.validate) {
-      auto record = load_record(model, std::move(input), run.loaded.bind, run.settings.records.share);
+      const std::size_t known = run.loaded.outliers.size();
+      auto record = load_record(model, std::move(input), run.loaded.bind, run.settings.records.share,
+                                run.settings.records.keep_outliers ? nullptr : &run.loaded.outliers);
+      for (std::size_t k = known; k < run.loaded.outliers.size(); ++k)
+        out.warning(outlier_warning(run.loaded.outliers[k], "sidc fit", run.settings.records.keep_outliers_name));
       if (auto* d = std::get_if<Diagnostic>(&record)) return failure(*d);
       extra.push_back(std::get<SampledRecord>(std::move(record)));
     }
@@ -324,7 +332,8 @@ FitFiles fit_files_of(const FitRun& run) {
           run.instrumental_variables ? &*run.instrumental_variables : nullptr,
           run.local ? &*run.local : nullptr,
           run.nonlinear && run.nonlinear->projection ? &*run.nonlinear->projection : nullptr,
-          run.noise_check ? &*run.noise_check : nullptr};
+          run.noise_check ? &*run.noise_check : nullptr,
+          run.settings.records.keep_outliers ? nullptr : &run.loaded.outliers};
 }
 
 std::variant<std::vector<std::string>, Diagnostic> write_files(const FitRun& run, const std::string& directory) {

@@ -107,13 +107,19 @@ std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compil
     auto bound = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress, a.share);
     if (auto* d = std::get_if<Diagnostic>(&bound)) return *d;
     out.records.push_back(std::get<SampledRecord>(std::move(bound)));
+    if (!a.keep_outliers)
+      for (auto& scan : replace_isolated_outliers(out.records.back(), model)) out.outliers.push_back(std::move(scan));
   }
   return out;
 }
 
-std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind, PartShare* share) {
+std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind, PartShare* share,
+                                                    std::vector<OutlierScan>* outliers) {
   const ir::DataSource source = source_of(model, input);
-  return read_and_bind(std::move(input), source, model, bind, nullptr, share);
+  auto bound = read_and_bind(std::move(input), source, model, bind, nullptr, share);
+  if (auto* record = std::get_if<SampledRecord>(&bound); record && outliers)
+    for (auto& scan : replace_isolated_outliers(*record, model)) outliers->push_back(std::move(scan));
+  return bound;
 }
 
 }  // namespace sidc::driver

@@ -20,6 +20,7 @@
 #include "ir/compiled_model.hpp"
 #include "ir/settings.hpp"
 #include "runtime/records/bind_record.hpp"
+#include "runtime/records/isolated_outliers.hpp"
 #include "runtime/records/records.hpp"
 #include "runtime/solve/fit.hpp"
 
@@ -31,6 +32,10 @@ struct RecordSettings {
   std::optional<double> from, to, step, resample;
   std::optional<int> every;
   std::string derivative, second_derivative, edges, integration, precision, weights;
+  // Isolated outliers of the outputs kept as recorded (runtime/records/isolated_outliers.hpp);
+  // false: found, replaced by their neighbours' value and reported (`--keep-outliers`).
+  bool keep_outliers = false;
+  std::string keep_outliers_name = "--keep-outliers";  // how the face names that option in reports
   // The processes that read each record together, each its own byte range (CsvOptions::share; the
   // command line under mpirun; not owned). Null: every record read whole here.
   PartShare* share = nullptr;
@@ -52,6 +57,7 @@ struct LoadedRecords {
   std::vector<ir::DataSource> sources;  // paths resolved
   std::vector<SampledRecord> records;
   BindOptions bind;                     // as used, for further records (`--validate`)
+  std::vector<OutlierScan> outliers;    // every output's isolated outliers replaced, by record (none kept)
 };
 
 // The records `inputs` name, each bound as the model's first data statement; with none, the
@@ -62,8 +68,9 @@ std::variant<LoadedRecords, Diagnostic> load_records(
     const std::function<void(const std::string& phase, std::size_t done, std::size_t total)>& progress = nullptr);
 
 // One more record, bound like the others as the model's first data statement (read by `share`'s
-// processes together when given, as load_records reads with RecordSettings::share).
+// processes together when given, as load_records reads with RecordSettings::share), its outputs'
+// isolated outliers replaced and added to `outliers` unless that is null.
 std::variant<SampledRecord, Diagnostic> load_record(const ir::Model& model, RecordInput input, const BindOptions& bind,
-                                                    PartShare* share = nullptr);
+                                                    PartShare* share = nullptr, std::vector<OutlierScan>* outliers = nullptr);
 
 }  // namespace sidc::driver

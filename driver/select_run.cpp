@@ -142,9 +142,11 @@ std::optional<Failure> run_select(SelectRun& run, const FitOutput& out) {
                               d.set_aside ? fmt::format("; set aside before the search (give {} or {} to search it)", option_name(a, "keep-drift"),
                                                         option_name(a, "require"))
                                           : ""));
+  for (const auto& scan : run.loaded.outliers) out.warning(outlier_warning(scan, "sidc select", a.records.keep_outliers_name));
+  const std::string outliers = outlier_report(run.loaded.outliers, a.records.keep_outliers_name);
   out.report(fmt::format("sidc select: model `{}` ({}), size rule {}\n{}{}\n", model.name, run.model_path, to_string(o.rule), run.form_note,
                          a.processes.empty() ? "" : a.processes + "\n") +
-             summary.report());
+             outliers + (outliers.empty() ? "" : "\n") + summary.report());
   return std::nullopt;
 }
 

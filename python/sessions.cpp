@@ -85,7 +85,7 @@ std::variant<SelectResult, Failure> select_session(const LoadedModel& loaded, st
   driver::SelectRun& run = *std::get<std::unique_ptr<driver::SelectRun>>(prepared);
   SelectResult out;
   if (auto f = driver::run_select(run, kept(out.report, out.warnings))) return f->diagnostics;
-  out.document = select_json(*run.summary, loaded.path, run.options);
+  out.document = select_json(*run.summary, loaded.path, run.options, run.settings.records.keep_outliers ? nullptr : &run.loaded.outliers);
   non_finite_as_strings(out.document);
   return out;
 }

@@ -402,6 +402,17 @@ std::vector<std::string> fit_file_paths(const std::string& directory) {
 
 std::string select_file_path(const std::string& directory) { return (fs::path(directory) / "select.json").string(); }
 
+nlohmann::ordered_json outliers_json(const std::vector<OutlierScan>& scans) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const auto& scan : scans) {
+    nlohmann::ordered_json samples = nlohmann::ordered_json::array();
+    for (const auto& o : scan.found)
+      samples.push_back({{"sample", o.sample}, {"t", o.time}, {"recorded", o.value}, {"replaced_by", o.replacement}, {"scale_multiple", o.size}});
+    out.push_back({{"record", scan.record}, {"signal", scan.signal}, {"column", scan.column}, {"threshold", scan.threshold}, {"samples", std::move(samples)}});
+  }
+  return out;
+}
+
 nlohmann::ordered_json fit_document(const FitFiles& f) {
   auto json = fit_json(f.summary, f.compiled, f.compiled_path, f.options);
   if (f.validation) json["validation"] = validation_json(*f.validation, f.records.size());
@@ -419,6 +430,7 @@ nlohmann::ordered_json fit_document(const FitFiles& f) {
   json["refinement"] = f.refinement ? refinement_json(*f.refinement) : nlohmann::ordered_json(nullptr);
   json["instrumental_variables"] = f.instrumental_variables ? instrumental_variables_json(*f.instrumental_variables) : nlohmann::ordered_json(nullptr);
   json["noise_check"] = f.noise_check ? noise_check_json(*f.noise_check) : nlohmann::ordered_json(nullptr);
+  json["outliers"] = f.outliers ? outliers_json(*f.outliers) : nlohmann::ordered_json(nullptr);
   json["local"] = f.local ? local_json(*f.local) : nlohmann::ordered_json(nullptr);
   json["nonlinear_parameters"] = f.nonlinear ? nonlinear_json(*f.nonlinear) : nlohmann::ordered_json(nullptr);
   non_finite_as_strings(json);
@@ -458,7 +470,8 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
   return written;
 }
 
-nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& model_path, const SelectOptions& o) {
+nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& model_path, const SelectOptions& o,
+                                   const std::vector<OutlierScan>* outliers) {
   using nlohmann::ordered_json;
   ordered_json j;
   j["format"] = "sidc-select";
@@ -501,17 +514,18 @@ nlohmann::ordered_json select_json(const SelectSummary& s, const std::string& mo
                       {"bootstrap", {{"replicates", g.bootstrap_replicates}, {"blocks", g.blocks}, {"frequency", frequency}}}});
   }
   j["groups"] = std::move(groups);
+  j["outliers"] = outliers ? outliers_json(*outliers) : ordered_json(nullptr);
   return j;
 }
 
 std::variant<std::string, Diagnostic> write_select_file(const std::string& directory, const SelectSummary& summary, const std::string& model_path,
-                                                        const SelectOptions& options) {
+                                                        const SelectOptions& options, const std::vector<OutlierScan>* outliers) {
   std::error_code ec;
   fs::create_directories(directory, ec);
   if (ec) return cli_diag::cannot_create_directory(directory, ec.message());
   const std::string path = select_file_path(directory);
   std::string why;
-  auto json = select_json(summary, model_path, options);
+  auto json = select_json(summary, model_path, options, outliers);
   non_finite_as_strings(json);
   if (!write_file_atomically(path, json.dump(1) + "\n", &why)) return cli_diag::cannot_write(why);
   return path;

@@ -18,6 +18,7 @@
 #include "runtime/select/select.hpp"
 #include "runtime/simulate/form_choice.hpp"
 #include "runtime/simulate/validate.hpp"
+#include "runtime/records/isolated_outliers.hpp"
 #include "runtime/refine/refine.hpp"
 #include "runtime/solve/fit.hpp"
 #include "runtime/solve/instrumental_variables.hpp"
@@ -34,6 +35,7 @@ nlohmann::ordered_json validation_json(const FitValidation& validation, std::siz
 nlohmann::ordered_json residual_json(const ResidualAnalysis& analysis);
 nlohmann::ordered_json instrumental_variables_json(const InstrumentalVariablesSummary& iv);
 nlohmann::ordered_json noise_check_json(const NoiseCheck& check);
+nlohmann::ordered_json outliers_json(const std::vector<OutlierScan>& scans);
 // record,t, then per output: recorded, simulated, error; "" when nothing was simulated.
 std::string validation_csv(const FitValidation& validation);
 
@@ -70,6 +72,9 @@ struct FitFiles {
   // The noise check (noise_check.hpp); null when it was switched off or the model is static
   // (fit.json's `noise_check` is then null).
   const NoiseCheck* noise_check = nullptr;
+  // The outputs' isolated outliers replaced (isolated_outliers.hpp); null when they were kept
+  // (`--keep-outliers`: fit.json's `outliers` is then null; an empty list: none found).
+  const std::vector<OutlierScan>* outliers = nullptr;
 };
 
 // local.csv: one row per window (record, when several, then t_center, each parameter and its
@@ -91,11 +96,13 @@ std::variant<std::vector<std::string>, Diagnostic> write_fit_files(const std::st
 // The paths write_fit_files may write in DIR (fit.json, residuals.csv, validation.csv, local.csv).
 std::vector<std::string> fit_file_paths(const std::string& directory);
 
-nlohmann::ordered_json select_json(const SelectSummary& summary, const std::string& model_path, const SelectOptions& options);
+// `outliers`: the outputs' isolated outliers replaced (select.json's `outliers`, as fit.json's); null: kept.
+nlohmann::ordered_json select_json(const SelectSummary& summary, const std::string& model_path, const SelectOptions& options,
+                                   const std::vector<OutlierScan>* outliers = nullptr);
 // DIR/select.json.
 std::string select_file_path(const std::string& directory);
 // Writes DIR/select.json (creating DIR): its path, or the Diagnostic.
 std::variant<std::string, Diagnostic> write_select_file(const std::string& directory, const SelectSummary& summary, const std::string& model_path,
-                                                        const SelectOptions& options);
+                                                        const SelectOptions& options, const std::vector<OutlierScan>* outliers = nullptr);
 
 }  // namespace sidc

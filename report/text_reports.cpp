@@ -4,6 +4,7 @@
 #include <limits>
 #include <fmt/format.h>
 
+#include "diagnostics/time_text.hpp"
 #include "ir/queries.hpp"
 
 namespace sidc {
@@ -51,6 +52,35 @@ std::string operator_report(const std::vector<OperatorReport>& reports, const Ev
     }
   }
   return out;
+}
+
+std::string outlier_report(const std::vector<OutlierScan>& scans, const std::string& keep_option) {
+  constexpr std::size_t kListed = 10;
+  std::string out;
+  for (const auto& scan : scans) {
+    const std::size_t n = scan.found.size();
+    out += fmt::format("record {}: {} isolated sample{} of {} replaced by {} neighbours' value (outliers: off the quadratic through the\n"
+                       "  3 samples either side by more than {:.3g} times the residuals' robust scale, alone, and off the line each side\n"
+                       "  follows; {} keeps them)\n",
+                       scan.record, n, n == 1 ? "" : "s", scan.signal, n == 1 ? "its" : "their", scan.threshold, keep_option);
+    out += fmt::format("  {:>14} {:>14} {:>14} {:>12}\n", "t", "recorded", "replaced by", "|r| / scale");
+    for (std::size_t k = 0; k < std::min(n, kListed); ++k) {
+      const IsolatedOutlier& o = scan.found[k];
+      out += fmt::format("  {:>14} {:>14.7g} {:>14.7g} {:>12.3g}\n", time_text(o.time, scan.step, 6), o.value, o.replacement, o.size);
+    }
+    if (n > kListed) out += fmt::format("  ... and {} more (fit.json lists every one)\n", n - kListed);
+  }
+  return out;
+}
+
+std::string outlier_warning(const OutlierScan& scan, const std::string& command, const std::string& keep_option) {
+  const std::size_t n = scan.found.size();
+  std::string times;
+  for (std::size_t k = 0; k < std::min<std::size_t>(n, 5); ++k) times += (k ? ", " : "") + time_text(scan.found[k].time, scan.step, 6);
+  if (n > 5) times += ", ...";
+  return fmt::format("{}: warning: {}: {} isolated sample{} of `{}` replaced as outlier{} (t = {}): a single sample far off its neighbours "
+                     "is a glitch of the record, not of the model; {} keeps them",
+                     command, scan.record, n, n == 1 ? "" : "s", scan.signal, n == 1 ? "" : "s", times, keep_option);
 }
 
 std::string validation_report(const FitValidation& v, std::size_t fitted_records) {

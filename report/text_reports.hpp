@@ -5,6 +5,7 @@
 #include <string>
 
 #include "ir/ir.hpp"
+#include "runtime/records/isolated_outliers.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/model_comparison.hpp"
 #include "runtime/solve/residual_analysis.hpp"
@@ -15,6 +16,12 @@ namespace sidc {
 // by savgol(auto) with their estimated rms errors, or the one the settings name.
 // Noise levels and derivative errors carry the signals' units when the model gives them.
 std::string operator_report(const std::vector<OperatorReport>& reports, const EvaluationOptions& options, const ir::Model& model);
+// The outputs' isolated outliers replaced (runtime/records/isolated_outliers.hpp): one block per
+// record and output, each sample with its time, value, replacement and size; "" when none.
+// `keep_option` names the switch that keeps them (`--keep-outliers`, `keep_outliers=True`).
+std::string outlier_report(const std::vector<OutlierScan>& scans, const std::string& keep_option);
+// The same as one line for stderr, prefixed by `command` ("sidc fit").
+std::string outlier_warning(const OutlierScan& scan, const std::string& command, const std::string& keep_option);
 // `fitted_records`: how many of the runs are of fitted records; the rest are held out
 // (`--validate`), and each is marked so.
 std::string validation_report(const FitValidation& validation, std::size_t fitted_records);

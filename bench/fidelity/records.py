@@ -82,12 +82,37 @@ def noise_free(system, seed=1):
     return _CACHE[key]
 
 
-def noisy_outputs(record, level, seed):
+def noisy_outputs(record, level, seed, glitches=0):
     rng = random.Random(f"{record.system.name}/{level:g}/{seed}")
     out = {}
     for name, values in record.outputs.items():
         sigma = level * integrate.std(values)
         out[name] = [v + rng.gauss(0.0, sigma) for v in values] if sigma > 0 else list(values)
+    for name, at in glitch_samples(record, level, seed, glitches).items():
+        size = GLITCH_SHARE * integrate.std(record.outputs[name])
+        glitch_rng = random.Random(f"{record.system.name}/{level:g}/{seed}/glitch-signs/{name}")
+        for i in at:
+            out[name][i] += size if glitch_rng.random() < 0.5 else -size
+    return out
+
+
+# `--glitches K`: K samples of each output put off by a fifth of its s.d. (a sensor glitch), at
+# least 10 samples from the ends and from each other, drawn from their own stream.
+GLITCH_SHARE = 0.2
+
+
+def glitch_samples(record, level, seed, glitches):
+    if glitches <= 0:
+        return {}
+    out = {}
+    for name in record.outputs:
+        rng = random.Random(f"{record.system.name}/{level:g}/{seed}/glitches/{name}")
+        n, chosen = len(record.t), []
+        while len(chosen) < glitches and n > 40:
+            i = rng.randrange(10, n - 10)
+            if all(abs(i - j) >= 10 for j in chosen):
+                chosen.append(i)
+        out[name] = sorted(chosen)
     return out
 
 
@@ -115,10 +140,10 @@ def model_text(system, equations, kind, declare_params=True):
     return "\n".join(lines) + "\n"
 
 
-def write_case(directory, system, level, seed, record=None, truth_csv=True):
+def write_case(directory, system, level, seed, record=None, truth_csv=True, glitches=0):
     record = record or noise_free(system, seed)
     os.makedirs(directory, exist_ok=True)
-    outputs = noisy_outputs(record, level, seed)
+    outputs = noisy_outputs(record, level, seed, glitches)
     files = {
         "record.csv": csv_text(record.t, record.inputs, outputs),
         "truth.csv": csv_text(record.t, record.inputs, record.outputs),
@@ -133,6 +158,7 @@ def write_case(directory, system, level, seed, record=None, truth_csv=True):
         "step": system.step, "samples": system.samples,
         "noise_level": level, "noise_seed": f"{system.name}/{level:g}/{seed}",
         "noise_sd": {name: level * integrate.std(v) for name, v in record.outputs.items()},
+        "glitches": glitch_samples(record, level, seed, glitches),
         "inputs_noise_free": True,
         "generator": f"RK4, {system.substeps} steps per sample interval"
                      + (", velocity reversals located (Coulomb friction)" if system.sliding else "")

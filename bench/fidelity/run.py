@@ -178,9 +178,9 @@ def chaotic_truth_fit_percent(system, estimates):
     return min(fit_percent(record.outputs[name], simulated[name]) for name in system.outputs)
 
 
-def run_case(sidc, work, config, system, level, seed, timeout, bound=False):
+def run_case(sidc, work, config, system, level, seed, timeout, bound=False, glitches=0):
     d = os.path.join(work, config.name, system.name, f"noise{level:g}_s{seed}")
-    truth = records.write_case(d, system, level, seed)
+    truth = records.write_case(d, system, level, seed, glitches=glitches)
     base_model = open(os.path.join(d, "model.sid")).read()
     with open(os.path.join(d, "truth_model.sid"), "w") as f:
         f.write(base_model)
@@ -197,7 +197,8 @@ def run_case(sidc, work, config, system, level, seed, timeout, bound=False):
            "select_exit": None, "select_error": "", "selected": None, "select_recovered": None,
            "seconds": 0.0, "equation_error_max_rel_error": None, "iv_termination": None, "iv_iterations": None,
            "refined": None, "covered": None, "intervals": None, "covered_hac": None, "covered_check": None, "check_flags": None,
-           "bound": None, "bound_parameter": None}
+           "bound": None, "bound_parameter": None, "outliers": None, "glitches_found": None,
+           "glitches": sum(len(v) for v in truth.get("glitches", {}).values())}
 
     # 1. the fit of the true terms
     rc, err, secs = run([sidc, "fit", "model.sid", "--out", "fit"] + config.fit_options, d, timeout)
@@ -212,6 +213,12 @@ def run_case(sidc, work, config, system, level, seed, timeout, bound=False):
         ci = {p["name"]: p.get("hac_ci95") if gi < len(trusted) and trusted[gi] and p.get("hac_ci95") else p.get("ci95")
               for gi, g in enumerate(fit.get("groups", [])) for p in g.get("parameters", [])}
         held_values = {p["name"]: p["held"] for p in (fit.get("nonlinear_parameters") or {}).get("parameters", [])}
+        # Samples replaced as isolated outliers (none expected without --glitches), and of them the
+        # glitches put in.
+        replaced = [(s["signal"], x["sample"]) for s in (fit.get("outliers") or []) for x in s["samples"]]
+        row["outliers"] = len(replaced)
+        put_in = {(name, i) for name, at in truth.get("glitches", {}).items() for i in at}
+        row["glitches_found"] = len(put_in & set(replaced))
         row["equation_error_max_rel_error"] = max_relative_error({**est, **held_values}, system.truth)[0]
         iv = fit.get("instrumental_variables")  # `set estimator = iv`: its estimate is the one judged
         if iv:
@@ -435,6 +442,12 @@ def tables(rows, configs, systems, levels):
                    + (f" Where the noise check ran on the equation-error estimate ({len(checked)} noisy cases, {flagged} flagged), "
                       f"the classical intervals held {held_plain} of {judged_check}, widened to the copies' s.d. where larger "
                       f"{held_check} of {judged_check}." if checked else ""))
+        replaced = sum(r.get("outliers") or 0 for r in mine)
+        put_in = sum(r.get("glitches") or 0 for r in mine)
+        found = sum(r.get("glitches_found") or 0 for r in mine)
+        out.append(f"Isolated outliers replaced by the fit: {replaced} samples" +
+                   (f", {found} of the {put_in} glitches put in (--glitches), {replaced - found} elsewhere." if put_in else
+                    " (no glitches put in: every one is a false alarm)."))
         out.append("")
     bounded = [r for r in rows if r.get("bound") is not None]
     if bounded:
@@ -506,7 +519,7 @@ CSV_FIELDS = ["config", "system", "noise", "seed", "fit_exit", "max_rel_error", 
               "validation_fit_percent", "truth_fit_percent", "truth_follows", "verdict_agrees", "select_exit",
               "selected", "select_recovered", "seconds", "fit_error", "select_error", "estimates",
               "equation_error_max_rel_error", "iv_termination", "iv_iterations", "refined", "covered", "intervals", "covered_hac",
-              "covered_check", "check_flags", "bound", "bound_parameter"]
+              "covered_check", "check_flags", "bound", "bound_parameter", "outliers", "glitches", "glitches_found"]
 
 
 def write_results(out_dir, rows, markdown):
@@ -543,6 +556,8 @@ def main():
     p.add_argument("--sensitivity", action="store_true",
                    help="only print how strict 'follows' is: fit %% of the truth with one parameter off by 0.1%% or 1%%")
     p.add_argument("--timeout", type=float, default=600, help="seconds per sidc command (default 600)")
+    p.add_argument("--glitches", type=int, default=0, metavar="K",
+                   help="put K glitches (a fifth of its s.d.) into each output of every record (records.py)")
     p.add_argument("--bound", action="store_true",
                    help="also compute each noisy record's Cramer-Rao bound (sidc fit --refine of the true terms) and tabulate it")
     a = p.parse_args()
@@ -577,7 +592,7 @@ def main():
     rows = []
     start = time.monotonic()
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = {pool.submit(run_case, sidc, a.work, c, s, lv, k, a.timeout, a.bound and c is configs[0]): (c, s, lv, k) for c, s, lv, k in jobs}
+        futures = {pool.submit(run_case, sidc, a.work, c, s, lv, k, a.timeout, a.bound and c is configs[0], a.glitches): (c, s, lv, k) for c, s, lv, k in jobs}
         for fut in concurrent.futures.as_completed(futures):
             c, s, lv, k = futures[fut]
             try:

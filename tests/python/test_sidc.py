@@ -147,6 +147,28 @@ class FitAgreesWithCli(Workspace):
         self.assertIn("parameters", checked)
         self.assertIsNone(json.loads(model.fit(read_record(self.csv), no_validate=True, no_noise_check=True).to_json())["noise_check"])
 
+    def test_isolated_outliers_are_replaced_as_the_cli_replaces_them(self):
+        record = read_record(self.csv)
+        glitched = dict(record, y=record["y"].copy())
+        glitched["y"][50] += 2.0  # y runs from -1.9 to 1.9, smoothly
+        before = glitched["y"].copy()
+        model = sidc.compile(self.model_path)
+        result = model.fit(glitched, no_validate=True)
+        found = result.document["outliers"]
+        self.assertEqual([(s["signal"], [x["sample"] for x in s["samples"]]) for s in found], [("y", [50])])
+        np.testing.assert_array_equal(glitched["y"], before)  # the caller's array is never written
+        # The CLI on the same record in a file: the same outliers and estimates.
+        path = os.path.join(self.dir, "glitched.csv")
+        np.savetxt(path, np.column_stack([glitched[n] for n in ("t", "y", "ydot", "yddot", "x")]), delimiter=",",
+                   header="t,y,ydot,yddot,x", comments="", fmt="%.17g")
+        cli = json.loads(self.cli_fit("--no-validate", "--data", path))
+        self.assertEqual(cli["outliers"][0]["samples"], found[0]["samples"])
+        self.assertEstimatesEqual(result.estimates, json.dumps(cli))
+        kept = model.fit(glitched, no_validate=True, keep_outliers=True)
+        self.assertIsNone(kept.document["outliers"])
+        self.assertNotEqual(kept.estimates, result.estimates)
+        self.assertEqual(model.fit(record, no_validate=True).document["outliers"], [])
+
     def test_several_records(self):
         half = os.path.join(self.dir, "second.csv")
         record = read_record(self.csv)

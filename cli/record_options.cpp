@@ -29,6 +29,8 @@ void add_record_options(CLI::App* cmd, RecordArguments& a) {
   cmd->add_option("--precision", s.precision, "Least-squares arithmetic: automatic, double or extended")
       ->check(CLI::IsMember({"automatic", "double", "extended"}));
   cmd->add_option("--weights", s.weights, "A record column weighting each row's residual (eq. 2-1.6)");
+  cmd->add_flag("--split-at-gaps", s.split_at_gaps,
+                "Cut each record at its gaps (missing samples, faulty cells) and fit the stretches as separate records");
   cmd->add_flag("--keep-outliers", s.keep_outliers,
                 "Keep the outputs' isolated outliers (default: replaced by their neighbours' value, and reported)");
 }

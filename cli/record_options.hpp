@@ -19,7 +19,7 @@ struct RecordArguments {
 };
 
 // Adds --data, --from, --to, --every, --step, --resample, --derivative, --second-derivative,
-// --edges, --integration, --precision, --weights and --keep-outliers to `command`.
+// --edges, --integration, --precision, --weights, --split-at-gaps and --keep-outliers to `command`.
 void add_record_options(CLI::App* command, RecordArguments& arguments);
 
 // The records `--data` names, as the library takes them (none: the model's data statements).

@@ -133,12 +133,12 @@ Diagnostic bad_cell(std::string_view path, int row, int column, std::string_view
   switch (fault) {
     case CellFault::empty:
       return located("data-empty-cell", path, row, column, fmt::format("empty cell in column `{}`", name),
-                     "every sample of a column the model uses must hold a number; fill the cell or choose a time "
-                     "window that leaves this row out");
+                     "every sample of a column the model uses must hold a number; fill the cell, choose a time "
+                     "window that leaves this row out, or give --split-at-gaps to fit the stretches either side as separate records");
     case CellFault::not_a_number:
       return located("data-nan-cell", path, row, column, fmt::format("cell{} in column `{}` is NaN", quoted, name),
-                     "sidc needs a finite number in every used sample; fill the gap or choose a time window that "
-                     "leaves this row out");
+                     "sidc needs a finite number in every used sample; fill the gap, choose a time window that "
+                     "leaves this row out, or give --split-at-gaps to fit the stretches either side as separate records");
     case CellFault::infinite:
       return located("data-infinite-cell", path, row, column,
                      fmt::format("cell{} in column `{}` is infinite", quoted, name),
@@ -207,8 +207,8 @@ Diagnostic time_step_not_uniform(std::string_view path, int row, int column, std
   return located("data-time-step-not-uniform", path, row, column,
                  fmt::format("time step of `{}` is {} here but {} elsewhere (tolerance {} relative)", shown(name),
                              found, expected, relative_tolerance),
-                 "derivatives and integrals need uniform sampling; use --resample to interpolate onto a uniform "
-                 "grid, or fix the missing or extra samples");
+                 "derivatives and integrals need uniform sampling; --split-at-gaps fits the stretches between gaps as "
+                 "separate records, --resample interpolates onto a uniform grid; or fix the missing or extra samples");
 }
 
 Diagnostic invalid_resampling_step(double step) {
@@ -235,6 +235,15 @@ Diagnostic empty_time_window(std::string_view path, std::string_view name, doubl
                  fmt::format("no sample of `{}` lies in the window [{}, {}]; the record spans [{}, {}]", shown(name),
                              from, to, first, last),
                  "choose a window inside the record");
+}
+
+Diagnostic no_stretch_to_fit(std::string_view path) {
+  Diagnostic d;
+  d.code = "data-no-stretch";
+  d.message = fmt::format("`{}` has no two neighbouring rows whose every used column holds a number: no stretch of it can be fitted",
+                          shown_path(path));
+  d.hint = "check the columns the model reads (its data statement binds them)";
+  return d;
 }
 
 Diagnostic no_time_column(std::string_view path, int header_row) {

@@ -186,7 +186,7 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
   for (const auto& scan : run.loaded.outliers) out.warning(outlier_warning(scan, "sidc fit", keep));
   const std::string outliers = outlier_report(run.loaded.outliers, keep);
   std::string report = fmt::format("sidc fit: model `{}` ({})\n{}\n", model.name, run.model_path, a.processes.empty() ? "" : a.processes + "\n") + form_report + (form_report.empty() ? "" : "\n") +
-                       outliers + (outliers.empty() ? "" : "\n") +
+                       run.loaded.notes + (run.loaded.notes.empty() ? "" : "\n") + outliers + (outliers.empty() ? "" : "\n") +
                        operator_report(summary.operators, o.evaluation, model);
   if (!is_static(model)) report += "\n";
   out.report(report + summary.full_report(model));

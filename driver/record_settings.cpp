@@ -3,9 +3,12 @@
 #include <charconv>
 #include <filesystem>
 
+#include <fmt/format.h>
+
 #include "diagnostics/cli_catalogue.hpp"
 #include "diagnostics/data_catalogue.hpp"
 #include "diagnostics/model_catalogue.hpp"
+#include "diagnostics/time_text.hpp"
 #include "runtime/solve/options_from_settings.hpp"
 
 namespace sidc::driver {
@@ -69,18 +72,76 @@ ir::DataSource source_of(const ir::Model& model, const RecordInput& input) {
 
 using Progress = std::function<void(const std::string& phase, std::size_t done, std::size_t total)>;
 
-std::variant<SampledRecord, Diagnostic> read_and_bind(RecordInput input, const ir::DataSource& source, const ir::Model& model, const BindOptions& bind,
-                                                      const Progress& progress = nullptr, PartShare* share = nullptr) {
+std::variant<Record, Diagnostic> read(RecordInput input, const Progress& progress, PartShare* share) {
   CsvOptions csv;
   csv.share = share;
   if (progress && std::holds_alternative<std::string>(input))
     csv.progress = [&progress, phase = "reading " + std::get<std::string>(input) + " (bytes)"](std::size_t done, std::size_t total) {
       progress(phase, done, total);
     };
-  auto record = std::holds_alternative<std::string>(input) ? read_csv(std::get<std::string>(input), csv)
-                                                           : std::variant<Record, Diagnostic>(std::get<Record>(std::move(input)));
+  if (std::holds_alternative<std::string>(input)) return read_csv(std::get<std::string>(input), csv);
+  return std::get<Record>(std::move(input));
+}
+
+std::variant<SampledRecord, Diagnostic> read_and_bind(RecordInput input, const ir::DataSource& source, const ir::Model& model, const BindOptions& bind,
+                                                      const Progress& progress = nullptr, PartShare* share = nullptr) {
+  auto record = read(std::move(input), progress, share);
   if (auto* d = std::get_if<Diagnostic>(&record)) return *d;
   return bind_record(std::get<Record>(std::move(record)), source, model, bind);
+}
+
+std::string lines_of(const Record& record, IndexRange rows) {
+  return fmt::format("lines {}-{}", record.line_of_row(rows.begin), record.line_of_row(rows.end - 1));
+}
+
+// The record cut at its gaps into unbroken stretches, each bound as a record named by its lines;
+// `notes` gets a paragraph saying what was cut and left out.
+std::variant<std::vector<SampledRecord>, Diagnostic> split_and_bind(RecordInput input, const ir::DataSource& source, const ir::Model& model,
+                                                                    const BindOptions& bind, const Progress& progress, PartShare* share,
+                                                                    std::string& notes) {
+  auto read_record = read(std::move(input), progress, share);
+  if (auto* d = std::get_if<Diagnostic>(&read_record)) return *d;
+  const Record& record = std::get<Record>(read_record);
+  auto found = unbroken_stretches(record, source, model, bind, kMinStretchRows);
+  if (auto* d = std::get_if<Diagnostic>(&found)) return *d;
+  const Stretches& stretches = std::get<Stretches>(found);
+  if (stretches.kept.empty())
+    return diag::error("data-no-stretch", Span{},
+                       fmt::format("`{}` has no unbroken stretch of {} rows or more between its gaps ({} shorter)", record.path, kMinStretchRows,
+                                   stretches.short_ones.size()),
+                       "fill the gaps, or --resample to interpolate across them");
+  std::vector<SampledRecord> out;
+  if (stretches.kept.size() == 1 && stretches.kept.front().size() == record.rows()) {
+    notes += fmt::format("record {}: no gap to split at: fitted whole\n", record.path);
+    auto bound = bind_record(std::get<Record>(std::move(read_record)), source, model, bind);
+    if (auto* d = std::get_if<Diagnostic>(&bound)) return *d;
+    out.push_back(std::get<SampledRecord>(std::move(bound)));
+    return out;
+  }
+  std::string pieces;
+  for (const IndexRange& rows : stretches.kept) {
+    Record piece = select_rows(record, rows);
+    piece.path = fmt::format("{} ({})", record.path, lines_of(record, rows));
+    auto bound = bind_record(std::move(piece), source, model, bind);
+    if (auto* d = std::get_if<Diagnostic>(&bound)) return *d;
+    const SampledRecord& r = std::get<SampledRecord>(bound);
+    pieces += fmt::format("  {}: {} rows, t = {} to {}\n", lines_of(record, rows), rows.size(), time_text(r.time.front(), r.step, 6),
+                          time_text(r.time.back(), r.step, 6));
+    out.push_back(std::get<SampledRecord>(std::move(bound)));
+  }
+  notes += fmt::format("record {}: split at its gaps into {} stretches, each fitted as a record of its own (its own\n"
+                       "  initial state and integration constants):\n{}",
+                       record.path, out.size(), pieces);
+  if (stretches.rows_left_out > 0)
+    notes += fmt::format("  left out: {} row{} with a faulty cell in a column the model reads\n", stretches.rows_left_out,
+                         stretches.rows_left_out == 1 ? "" : "s");
+  if (!stretches.short_ones.empty()) {
+    std::size_t rows = 0;
+    for (const auto& s : stretches.short_ones) rows += s.size();
+    notes += fmt::format("  left out: {} stretch{} under {} rows ({} rows in all; the first: {})\n", stretches.short_ones.size(),
+                         stretches.short_ones.size() == 1 ? "" : "es", kMinStretchRows, rows, lines_of(record, stretches.short_ones.front()));
+  }
+  return out;
 }
 
 }  // namespace
@@ -103,13 +164,26 @@ std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compil
   if (auto* d = std::get_if<Diagnostic>(&settings)) return *d;
   out.bind = bind_options(std::get<EvaluationSettings>(settings));
   out.bind.resample = a.resample;
+  std::vector<ir::DataSource> sources;  // one per record bound: a record split at its gaps gives several
   for (std::size_t i = 0; i < inputs.size(); ++i) {
-    auto bound = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress, a.share);
-    if (auto* d = std::get_if<Diagnostic>(&bound)) return *d;
-    out.records.push_back(std::get<SampledRecord>(std::move(bound)));
-    if (!a.keep_outliers)
-      for (auto& scan : replace_isolated_outliers(out.records.back(), model)) out.outliers.push_back(std::move(scan));
+    std::vector<SampledRecord> bound;
+    if (a.split_at_gaps) {
+      auto pieces = split_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress, a.share, out.notes);
+      if (auto* d = std::get_if<Diagnostic>(&pieces)) return *d;
+      bound = std::get<std::vector<SampledRecord>>(std::move(pieces));
+    } else {
+      auto whole = read_and_bind(std::move(inputs[i]), out.sources[i], model, out.bind, progress, a.share);
+      if (auto* d = std::get_if<Diagnostic>(&whole)) return *d;
+      bound.push_back(std::get<SampledRecord>(std::move(whole)));
+    }
+    for (auto& record : bound) {
+      out.records.push_back(std::move(record));
+      sources.push_back(out.sources[i]);
+      if (!a.keep_outliers)
+        for (auto& scan : replace_isolated_outliers(out.records.back(), model)) out.outliers.push_back(std::move(scan));
+    }
   }
+  out.sources = std::move(sources);
   return out;
 }
 

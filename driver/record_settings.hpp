@@ -36,6 +36,9 @@ struct RecordSettings {
   // false: found, replaced by their neighbours' value and reported (`--keep-outliers`).
   bool keep_outliers = false;
   std::string keep_outliers_name = "--keep-outliers";  // how the face names that option in reports
+  // A record with gaps (missing samples, faulty cells in the columns read) cut into its unbroken
+  // stretches, each fitted as a record of its own (runtime/records/bind_record.hpp, unbroken_stretches).
+  bool split_at_gaps = false;
   // The processes that read each record together, each its own byte range (CsvOptions::share; the
   // command line under mpirun; not owned). Null: every record read whole here.
   PartShare* share = nullptr;
@@ -58,7 +61,11 @@ struct LoadedRecords {
   std::vector<SampledRecord> records;
   BindOptions bind;                     // as used, for further records (`--validate`)
   std::vector<OutlierScan> outliers;    // every output's isolated outliers replaced, by record (none kept)
+  std::string notes;                    // what was done to the records before binding (split at gaps), for the report
 };
+
+// Stretches of a record split at its gaps shorter than this are left out (and listed).
+inline constexpr std::size_t kMinStretchRows = 20;
 
 // The records `inputs` name, each bound as the model's first data statement; with none, the
 // model's own data statements, relative paths taken from `directory` (the model file's folder).

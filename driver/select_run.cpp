@@ -146,7 +146,7 @@ std::optional<Failure> run_select(SelectRun& run, const FitOutput& out) {
   const std::string outliers = outlier_report(run.loaded.outliers, a.records.keep_outliers_name);
   out.report(fmt::format("sidc select: model `{}` ({}), size rule {}\n{}{}\n", model.name, run.model_path, to_string(o.rule), run.form_note,
                          a.processes.empty() ? "" : a.processes + "\n") +
-             outliers + (outliers.empty() ? "" : "\n") + summary.report());
+             run.loaded.notes + (run.loaded.notes.empty() ? "" : "\n") + outliers + (outliers.empty() ? "" : "\n") + summary.report());
   return std::nullopt;
 }
 

@@ -234,7 +234,7 @@ class Keywords {
 };
 
 const std::vector<std::string> kRecordKeywords{"from", "to", "every", "step", "resample", "derivative", "second_derivative",
-                                               "edges", "integration", "precision", "weights", "keep_outliers"};
+                                               "edges", "integration", "precision", "weights", "split_at_gaps", "keep_outliers"};
 
 std::vector<std::string> with_record_keywords(std::vector<std::string> own) {
   own.insert(own.begin(), kRecordKeywords.begin(), kRecordKeywords.end());
@@ -258,6 +258,7 @@ RecordSettings record_settings(const Keywords& k) {
   k.text("integration", r.integration, {"simpson", "trapezoid"});
   k.text("precision", r.precision, {"automatic", "double", "extended"});
   k.text("weights", r.weights);
+  k.flag("split_at_gaps", r.split_at_gaps);
   k.flag("keep_outliers", r.keep_outliers);
   r.keep_outliers_name = "keep_outliers=True";
   return r;

@@ -97,7 +97,7 @@ class Model:
         """Fit to `data`: a CSV path, a dict of 1-D arrays (named like CSV columns; `t` is time), a
         list of either (several records), or None for the model's data statements. `settings`: the
         options of `sidc fit` (from_, to, every, step, resample, derivative, second_derivative,
-        edges, integration, precision, weights, keep_outliers, integrate, form, no_validate, validate,
+        edges, integration, precision, weights, split_at_gaps, keep_outliers, integrate, form, no_validate, validate,
         validate_samples, refine_samples, refine_segments, initial_state, refine, no_noise_check, estimator, local,
         stride, forget)."""
         return FitResult(_sidc.fit(self._handle, data, settings))

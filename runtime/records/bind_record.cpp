@@ -1,5 +1,6 @@
 #include "runtime/records/bind_record.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <map>
@@ -20,6 +21,14 @@ bool bound(const ir::DataSource& source, const std::string& signal) {
   for (const auto& [name, column] : source.bindings)
     if (name == signal) return true;
   return false;
+}
+
+// The column bound to `t`, else one named `t` or `time`; "" when there is none.
+std::string time_column_of(const Record& record, const ir::DataSource& source) {
+  if (bound(source, "t")) return column_for(source, "t");
+  if (record.column("t")) return "t";
+  if (record.column("time")) return "time";
+  return {};
 }
 
 // The binding itself. With `owned` (the record is the caller's to give away), a column used once is
@@ -43,10 +52,7 @@ std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned
   const std::size_t rows = record.rows();
 
   // The time grid.
-  std::string time_column;
-  if (bound(source, "t")) time_column = column_for(source, "t");
-  else if (record.column("t")) time_column = "t";
-  else if (record.column("time")) time_column = "time";
+  const std::string time_column = time_column_of(record, source);
   if (!time_column.empty()) count_use(time_column);
   for (const auto& s : model.signals)
     if (!s.definition) count_use(column_for(source, s.name));
@@ -127,6 +133,57 @@ std::variant<SampledRecord, Diagnostic> bind(const Record& record, Record* owned
 }
 
 }  // namespace
+
+std::variant<Stretches, Diagnostic> unbroken_stretches(const Record& record, const ir::DataSource& source, const ir::Model& model,
+                                                       const BindOptions& options, std::size_t min_rows) {
+  const std::string time_column = time_column_of(record, source);
+  if (time_column.empty()) return data_diag::no_time_column(record.path, record.header_line > 0 ? record.header_line : 1);
+  // The columns read: a missing one is the binding's error, not a gap.
+  std::vector<const Column*> read;
+  std::vector<std::string> names{time_column};
+  for (const auto& s : model.signals)
+    if (!s.definition) names.push_back(column_for(source, s.name));
+  if (options.weights) names.push_back(*options.weights);
+  for (const auto& name : names) {
+    const Column* column = record.column(name);
+    if (!column) return std::get<Diagnostic>(complete_column(record, name));  // the did-you-mean diagnostic
+    read.push_back(column);
+  }
+  const Column& time = *read.front();
+  const std::size_t n = record.rows();
+  std::vector<char> good(n);
+  for (std::size_t i = 0; i < n; ++i)
+    good[i] = std::all_of(read.begin(), read.end(), [i](const Column* c) { return std::isfinite((*c)[i]); });
+  // The typical spacing: the median over neighbouring good rows.
+  std::vector<double> spacing;
+  for (std::size_t i = 1; i < n; ++i)
+    if (good[i] && good[i - 1]) spacing.push_back(time[i] - time[i - 1]);
+  if (spacing.empty()) return data_diag::no_stretch_to_fit(record.path);
+  const auto middle = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
+  std::nth_element(spacing.begin(), middle, spacing.end());
+  const double step = *middle;
+  const double allowed = options.uniform.relative_tolerance * std::abs(step);
+  Stretches out;
+  IndexRange current{0, 0};
+  const auto close = [&](std::size_t end) {
+    current.end = end;
+    if (!current.empty()) (current.size() >= min_rows ? out.kept : out.short_ones).push_back(current);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!good[i]) {
+      ++out.rows_left_out;
+      close(i);
+      current.begin = i + 1;
+      continue;
+    }
+    if (i > current.begin && !(step > 0 && std::abs(time[i] - time[i - 1] - step) <= allowed)) {
+      close(i);
+      current.begin = i;
+    }
+  }
+  close(n);
+  return out;
+}
 
 std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const ir::DataSource& source,
                                                     const ir::Model& model, const BindOptions& options) {

@@ -29,6 +29,21 @@ struct BindOptions {
 std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const ir::DataSource& source,
                                                     const ir::Model& model, const BindOptions& options);
 
+// A record with gaps (`--split-at-gaps`): the longest stretches of rows on which it can be bound,
+// each of uniform time step with every column the model reads (time, signals, weights) a finite
+// number. A stretch ends where a row has a faulty cell in such a column (the row is left out) or
+// where the spacing of times leaves the tolerance of the median spacing of the record (a missing
+// sample, a clock jump, a repeated or backward time). Stretches shorter than `min_rows` are
+// returned in `short_ones`, not in `kept`. A record without a time column, or whose times are all
+// faulty, is an error (nothing tells where a gap is).
+struct Stretches {
+  std::vector<IndexRange> kept;
+  std::vector<IndexRange> short_ones;
+  std::size_t rows_left_out = 0;  // rows with a faulty cell
+};
+std::variant<Stretches, Diagnostic> unbroken_stretches(const Record& record, const ir::DataSource& source, const ir::Model& model,
+                                                       const BindOptions& options, std::size_t min_rows);
+
 // The same on a record the caller gives away: the columns used once are moved into the
 // SampledRecord, not copied (the record is left with those columns empty).
 std::variant<SampledRecord, Diagnostic> bind_record(Record&& record, const ir::DataSource& source, const ir::Model& model,

@@ -169,6 +169,21 @@ class FitAgreesWithCli(Workspace):
         self.assertNotEqual(kept.estimates, result.estimates)
         self.assertEqual(model.fit(record, no_validate=True).document["outliers"], [])
 
+    def test_split_at_gaps_is_the_clis(self):
+        # Appendix A with its row at t = 0.5 lost: refused whole, fitted as two stretches.
+        lines = open(self.csv).read().splitlines(keepends=True)
+        path = os.path.join(self.dir, "lost_row.csv")
+        with open(path, "w") as f:
+            f.writelines(line for line in lines if not line.startswith("0.50,"))
+        model = sidc.compile(self.model_path)
+        with self.assertRaises(sidc.ModelError) as caught:
+            model.fit(path, no_validate=True)
+        self.assertEqual(caught.exception.code, "data-time-step-not-uniform")
+        result = model.fit(path, no_validate=True, split_at_gaps=True)
+        cli = self.cli_fit("--no-validate", "--split-at-gaps", "--data", path)
+        self.assertEstimatesEqual(result.estimates, cli)
+        self.assertIn("split at its gaps into 2 stretches", result.report())
+
     def test_several_records(self):
         half = os.path.join(self.dir, "second.csv")
         record = read_record(self.csv)

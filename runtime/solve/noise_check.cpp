@@ -7,6 +7,8 @@
 #include <map>
 #include <random>
 
+#include "runtime/parallel_ranges.hpp"
+
 namespace sidc {
 
 namespace {
@@ -121,31 +123,52 @@ NoiseCheck check_noise(const ir::Model& model, const std::vector<SampledRecord>&
   o.same_choices_as = &fitted;
   o.progress = {};
   o.share = nullptr;
+  // Every copy's noise drawn first, in the order one thread drawing copy after copy would draw it
+  // (record, output, sample), so that the copies, refitted on every core, are the same bits on any
+  // number of them.
+  std::size_t per_copy = 0;
+  for (std::size_t r = 0; r < records.size(); ++r)
+    for (const auto& entry : noise[r]) per_copy += records[r].signals.at(entry.first).size();
+  const auto replicates = static_cast<std::size_t>(check.replicates);
+  std::vector<double> draws(per_copy * replicates);
   std::mt19937_64 random(check.seed);
   std::normal_distribution<double> normal;
-  std::vector<std::vector<double>> values;  // per replicate, every group's columns in order
-  std::vector<SampledRecord> copies = records;
-  for (int b = 0; b < check.replicates; ++b) {
-    for (std::size_t r = 0; r < records.size(); ++r)
-      for (const auto& [name, sigma] : noise[r]) {
-        auto& copy = copies[r].signals.at(name).owned();
-        const Column& original = records[r].signals.at(name);
-        for (std::size_t i = 0; i < copy.size(); ++i) copy[i] = original[i] + sigma * normal(random);
-      }
-    auto refit = fit(model, copies, o);
-    if (auto* d = std::get_if<Diagnostic>(&refit)) {
-      out.not_run = "a copy with noise added could not be fitted: " + d->message;
+  for (double& d : draws) d = normal(random);
+
+  std::vector<std::vector<double>> values(replicates);  // per copy, every group's columns in order
+  std::vector<std::string> failures(replicates);        // why a copy could not be fitted ("" if it was)
+  for_parallel_ranges(
+      replicates, 0,
+      [&](std::size_t first, std::size_t last) {
+        std::vector<SampledRecord> copies = records;
+        for (std::size_t b = first; b < last; ++b) {
+          const double* d = draws.data() + b * per_copy;
+          for (std::size_t r = 0; r < records.size(); ++r)
+            for (const auto& [name, sigma] : noise[r]) {
+              auto& copy = copies[r].signals.at(name).owned();
+              const Column& original = records[r].signals.at(name);
+              for (std::size_t i = 0; i < copy.size(); ++i) copy[i] = original[i] + sigma * *d++;
+            }
+          auto refit = fit(model, copies, o);
+          if (auto* problem = std::get_if<Diagnostic>(&refit)) {
+            failures[b] = "a copy with noise added could not be fitted: " + problem->message;
+            continue;
+          }
+          const FitSummary& s = std::get<FitSummary>(refit);
+          if (!s.is_solution_usable()) {
+            failures[b] = "a copy with noise added has no usable solution (its design is rank deficient)";
+            continue;
+          }
+          for (const auto& g : s.groups)
+            for (const auto& p : g.summary.parameters) values[b].push_back(p.value);
+        }
+      },
+      0);
+  for (const auto& why : failures)
+    if (!why.empty()) {
+      out.not_run = why;
       return out;
     }
-    const FitSummary& s = std::get<FitSummary>(refit);
-    if (!s.is_solution_usable()) {
-      out.not_run = "a copy with noise added has no usable solution (its design is rank deficient)";
-      return out;
-    }
-    std::vector<double>& v = values.emplace_back();
-    for (const auto& g : s.groups)
-      for (const auto& p : g.summary.parameters) v.push_back(p.value);
-  }
 
   std::size_t k = 0;
   const double n = static_cast<double>(values.size());

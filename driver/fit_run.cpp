@@ -183,8 +183,9 @@ std::optional<Failure> run_fit(FitRun& run, const FitOutput& out) {
     for (const auto& w : drift_warnings(model, g.drift)) out.warning(render(w));
   for (const auto& w : statistics_warnings(model, summary)) out.warning(render(w));
   const std::string& keep = a.records.keep_outliers_name;
+  for (const auto& c : run.loaded.clipped) out.warning(clipping_warning(c, "sidc fit"));
   for (const auto& scan : run.loaded.outliers) out.warning(outlier_warning(scan, "sidc fit", keep));
-  const std::string outliers = outlier_report(run.loaded.outliers, keep);
+  const std::string outliers = clipping_report(run.loaded.clipped) + outlier_report(run.loaded.outliers, keep);
   std::string report = fmt::format("sidc fit: model `{}` ({})\n{}\n", model.name, run.model_path, a.processes.empty() ? "" : a.processes + "\n") + form_report + (form_report.empty() ? "" : "\n") +
                        run.loaded.notes + (run.loaded.notes.empty() ? "" : "\n") + outliers + (outliers.empty() ? "" : "\n") +
                        operator_report(summary.operators, o.evaluation, model);

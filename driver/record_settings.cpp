@@ -177,6 +177,7 @@ std::variant<LoadedRecords, Diagnostic> load_records(const CompiledModel& compil
       bound.push_back(std::get<SampledRecord>(std::move(whole)));
     }
     for (auto& record : bound) {
+      for (auto& c : clipped_outputs(record, model)) out.clipped.push_back(std::move(c));
       out.records.push_back(std::move(record));
       sources.push_back(out.sources[i]);
       if (!a.keep_outliers)

@@ -20,6 +20,7 @@
 #include "ir/compiled_model.hpp"
 #include "ir/settings.hpp"
 #include "runtime/records/bind_record.hpp"
+#include "runtime/records/clipping.hpp"
 #include "runtime/records/isolated_outliers.hpp"
 #include "runtime/records/records.hpp"
 #include "runtime/solve/fit.hpp"
@@ -62,6 +63,7 @@ struct LoadedRecords {
   BindOptions bind;                     // as used, for further records (`--validate`)
   std::vector<OutlierScan> outliers;    // every output's isolated outliers replaced, by record (none kept)
   std::string notes;                    // what was done to the records before binding (split at gaps), for the report
+  std::vector<Clipping> clipped;        // outputs that look clipped (a sensor at the end of its range), by record
 };
 
 // Stretches of a record split at its gaps shorter than this are left out (and listed).

@@ -142,8 +142,9 @@ std::optional<Failure> run_select(SelectRun& run, const FitOutput& out) {
                               d.set_aside ? fmt::format("; set aside before the search (give {} or {} to search it)", option_name(a, "keep-drift"),
                                                         option_name(a, "require"))
                                           : ""));
+  for (const auto& c : run.loaded.clipped) out.warning(clipping_warning(c, "sidc select"));
   for (const auto& scan : run.loaded.outliers) out.warning(outlier_warning(scan, "sidc select", a.records.keep_outliers_name));
-  const std::string outliers = outlier_report(run.loaded.outliers, a.records.keep_outliers_name);
+  const std::string outliers = clipping_report(run.loaded.clipped) + outlier_report(run.loaded.outliers, a.records.keep_outliers_name);
   out.report(fmt::format("sidc select: model `{}` ({}), size rule {}\n{}{}\n", model.name, run.model_path, to_string(o.rule), run.form_note,
                          a.processes.empty() ? "" : a.processes + "\n") +
              run.loaded.notes + (run.loaded.notes.empty() ? "" : "\n") + outliers + (outliers.empty() ? "" : "\n") + summary.report());

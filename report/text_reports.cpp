@@ -83,6 +83,37 @@ std::string outlier_warning(const OutlierScan& scan, const std::string& command,
                      command, scan.record, n, n == 1 ? "" : "s", scan.signal, n == 1 ? "" : "s", times, keep_option);
 }
 
+namespace {
+
+// "its largest value 5 in 14 runs (312 samples)" for each clipped side.
+std::string clipped_sides(const Clipping& c) {
+  std::string out;
+  for (const auto* side : {&c.top, &c.bottom}) {
+    if (!side->found) continue;
+    out += fmt::format("{}its {} value {:.7g} in {} run{} of 2 or more samples ({} samples)", out.empty() ? "" : " and ",
+                       side == &c.top ? "largest" : "smallest", side->value, side->runs, side->runs == 1 ? "" : "s", side->samples);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string clipping_report(const std::vector<Clipping>& clipped) {
+  std::string out;
+  for (const auto& c : clipped)
+    out += fmt::format("record {}: {} looks clipped (a sensor at the end of its range writes its rail value):\n"
+                       "  it sits at {}, from t = {} to {}.\n"
+                       "  There the record is not the system's output, the equations do not hold and the estimates are biased:\n"
+                       "  fit a window without those samples (--from, --to), or model the saturation\n",
+                       c.record, c.signal, clipped_sides(c), time_text(c.first_time, c.step, 6), time_text(c.last_time, c.step, 6));
+  return out;
+}
+
+std::string clipping_warning(const Clipping& c, const std::string& command) {
+  return fmt::format("{}: warning: {}: `{}` looks clipped: it sits at {} (t = {} to {}); the fit over those samples is biased",
+                     command, c.record, c.signal, clipped_sides(c), time_text(c.first_time, c.step, 6), time_text(c.last_time, c.step, 6));
+}
+
 std::string validation_report(const FitValidation& v, std::size_t fitted_records) {
   std::string out;
   if (!v.note.empty()) out += "\nvalidation: " + v.note + "\n";

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "ir/ir.hpp"
+#include "runtime/records/clipping.hpp"
 #include "runtime/records/isolated_outliers.hpp"
 #include "runtime/simulate/validate.hpp"
 #include "runtime/solve/model_comparison.hpp"
@@ -22,6 +23,10 @@ std::string operator_report(const std::vector<OperatorReport>& reports, const Ev
 std::string outlier_report(const std::vector<OutlierScan>& scans, const std::string& keep_option);
 // The same as one line for stderr, prefixed by `command` ("sidc fit").
 std::string outlier_warning(const OutlierScan& scan, const std::string& command, const std::string& keep_option);
+// Outputs that look clipped (runtime/records/clipping.hpp): a paragraph each for the report, and
+// a line each for stderr prefixed by `command`.
+std::string clipping_report(const std::vector<Clipping>& clipped);
+std::string clipping_warning(const Clipping& clipped, const std::string& command);
 // `fitted_records`: how many of the runs are of fitted records; the rest are held out
 // (`--validate`), and each is marked so.
 std::string validation_report(const FitValidation& validation, std::size_t fitted_records);

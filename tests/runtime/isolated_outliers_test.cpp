@@ -10,21 +10,12 @@
 #include <vector>
 
 #include "runtime/records/isolated_outliers.hpp"
+#include "support/sampled_signal.hpp"
 
 namespace sidc::outliers_test {
 
-std::vector<double> sampled(std::size_t n, double step, const std::function<double(double)>& f) {
-  std::vector<double> y(n);
-  for (std::size_t i = 0; i < n; ++i) y[i] = f(static_cast<double>(i) * step);
-  return y;
-}
-
-std::vector<double> noisy(std::vector<double> y, double sigma, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal(0.0, sigma);
-  for (double& v : y) v += normal(rng);
-  return y;
-}
+using testing::sampled;
+using testing::with_noise;
 
 double oscillation(double t) { return std::sin(0.7 * t) + 0.4 * std::sin(2.3 * t + 0.5); }
 
@@ -37,7 +28,7 @@ std::vector<std::size_t> samples_of(const std::vector<IsolatedOutlier>& found) {
 TEST(IsolatedOutliers, GlitchesAreFoundAtTheirSamplesAndReplacedWithinTheNoise) {
   const double sigma = 0.01;
   const std::vector<double> truth = sampled(4000, 0.05, oscillation);
-  std::vector<double> y = noisy(truth, sigma, 7);
+  std::vector<double> y = with_noise(truth, sigma, 7);
   const std::vector<std::size_t> glitches{5, 700, 1063, 2500, 3994};
   const std::vector<double> sizes{0.3, -0.5, 2.0, -0.15, 0.4};  // 15 to 200 noise levels
   for (std::size_t k = 0; k < glitches.size(); ++k) y[glitches[k]] += sizes[k];
@@ -67,7 +58,7 @@ TEST(IsolatedOutliers, CleanSignalsHaveNone) {
   for (std::size_t s = 0; s < shapes.size(); ++s)
     for (const double sigma : {0.0, 1e-4, 1e-3, 1e-2, 5e-2})
       for (unsigned seed = 1; seed <= 4; ++seed) {
-        const auto y = noisy(sampled(2000, 0.05, shapes[s]), sigma, seed);
+        const auto y = with_noise(sampled(2000, 0.05, shapes[s]), sigma, seed);
         EXPECT_TRUE(find_isolated_outliers(y).empty()) << "shape " << s << ", noise " << sigma << ", seed " << seed;
         ++signals;
       }
@@ -76,12 +67,12 @@ TEST(IsolatedOutliers, CleanSignalsHaveNone) {
 
 TEST(IsolatedOutliers, StepsKinksBurstsAndQuantisedSignalsAreNotIsolatedOutliers) {
   // A step between two samples: two neighbouring residuals of opposite sign, no spike.
-  EXPECT_TRUE(find_isolated_outliers(noisy(sampled(1000, 0.1, [](double t) { return std::sin(t) + (t > 50.02 ? 1.0 : 0.0); }), 1e-3, 3)).empty());
+  EXPECT_TRUE(find_isolated_outliers(with_noise(sampled(1000, 0.1, [](double t) { return std::sin(t) + (t > 50.02 ? 1.0 : 0.0); }), 1e-3, 3)).empty());
   // A kink (a jump of the slope) and a jump of the second derivative.
-  EXPECT_TRUE(find_isolated_outliers(noisy(sampled(1000, 0.1, [](double t) { return std::abs(t - 50.05); }), 1e-3, 4)).empty());
+  EXPECT_TRUE(find_isolated_outliers(with_noise(sampled(1000, 0.1, [](double t) { return std::abs(t - 50.05); }), 1e-3, 4)).empty());
   EXPECT_TRUE(find_isolated_outliers(sampled(1000, 0.1, [](double t) { return t > 50.05 ? (t - 50.05) * (t - 50.05) : 0.0; })).empty());
   // A burst of three bad samples in a row is no isolated sample: left for the user to see.
-  auto burst = noisy(sampled(1000, 0.1, [](double t) { return std::sin(t); }), 1e-3, 5);
+  auto burst = with_noise(sampled(1000, 0.1, [](double t) { return std::sin(t); }), 1e-3, 5);
   for (std::size_t i = 500; i < 503; ++i) burst[i] += 0.5;
   EXPECT_TRUE(find_isolated_outliers(burst).empty());
   // A slow signal read by a coarse converter: most residuals exactly 0, one quantum of dither.
@@ -127,10 +118,10 @@ TEST(IsolatedOutliers, KinksOfAStepResponseAreNotOutliers) {
 
 TEST(IsolatedOutliers, ConstantShortAndNonFiniteSignalsHaveNone) {
   EXPECT_TRUE(find_isolated_outliers(std::vector<double>(100, 2.5)).empty());
-  auto short_one = noisy(sampled(kMinOutlierSamples - 1, 0.1, oscillation), 1e-3, 1);
+  auto short_one = with_noise(sampled(kMinOutlierSamples - 1, 0.1, oscillation), 1e-3, 1);
   short_one[9] += 10;
   EXPECT_TRUE(find_isolated_outliers(short_one).empty());
-  auto with_nan = noisy(sampled(500, 0.1, oscillation), 1e-3, 1);
+  auto with_nan = with_noise(sampled(500, 0.1, oscillation), 1e-3, 1);
   with_nan[100] = 10;
   with_nan[300] = std::nan("");
   EXPECT_TRUE(find_isolated_outliers(with_nan).empty());
@@ -139,7 +130,7 @@ TEST(IsolatedOutliers, ConstantShortAndNonFiniteSignalsHaveNone) {
 TEST(IsolatedOutliers, ALongRecordIsScannedWhole) {
   // Beyond 200,000 samples the scale comes from evenly spaced stretches; every sample is examined.
   const std::size_t n = 1'000'000;
-  auto y = noisy(sampled(n, 0.001, oscillation), 1e-3, 11);
+  auto y = with_noise(sampled(n, 0.001, oscillation), 1e-3, 11);
   const std::vector<std::size_t> glitches{10, 123457, 500001, 999980};
   for (const std::size_t i : glitches) y[i] -= 0.05;
   EXPECT_EQ(samples_of(find_isolated_outliers(y)), glitches);

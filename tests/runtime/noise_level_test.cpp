@@ -9,22 +9,13 @@
 #include <vector>
 
 #include "runtime/operators/noise_level.hpp"
+#include "support/sampled_signal.hpp"
 
 namespace sidc {
 namespace {
 
-std::vector<double> sampled(std::size_t n, double step, const std::function<double(double)>& f) {
-  std::vector<double> y(n);
-  for (std::size_t i = 0; i < n; ++i) y[i] = f(static_cast<double>(i) * step);
-  return y;
-}
-
-std::vector<double> with_noise(std::vector<double> y, double sigma, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal(0.0, sigma);
-  for (double& v : y) v += normal(rng);
-  return y;
-}
+using testing::sampled;
+using testing::with_noise;
 
 struct Shape {
   const char* name;

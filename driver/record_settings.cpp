@@ -132,9 +132,11 @@ std::variant<std::vector<SampledRecord>, Diagnostic> split_and_bind(RecordInput 
   notes += fmt::format("record {}: split at its gaps into {} stretches, each fitted as a record of its own (its own\n"
                        "  initial state and integration constants):\n{}",
                        record.path, out.size(), pieces);
-  if (stretches.rows_left_out > 0)
-    notes += fmt::format("  left out: {} row{} with a faulty cell in a column the model reads\n", stretches.rows_left_out,
-                         stretches.rows_left_out == 1 ? "" : "s");
+  if (const std::size_t faulty = stretches.rows_left_out - stretches.rows_clipped; faulty > 0)
+    notes += fmt::format("  left out: {} row{} with a faulty cell in a column the model reads\n", faulty, faulty == 1 ? "" : "s");
+  if (stretches.rows_clipped > 0)
+    notes += fmt::format("  left out: {} row{} where an output sits at its rail (clipped: a sensor at the end of its range)\n",
+                         stretches.rows_clipped, stretches.rows_clipped == 1 ? "" : "s");
   if (!stretches.short_ones.empty()) {
     std::size_t rows = 0;
     for (const auto& s : stretches.short_ones) rows += s.size();

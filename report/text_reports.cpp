@@ -104,13 +104,14 @@ std::string clipping_report(const std::vector<Clipping>& clipped) {
     out += fmt::format("record {}: {} looks clipped (a sensor at the end of its range writes its rail value):\n"
                        "  it sits at {}, from t = {} to {}.\n"
                        "  There the record is not the system's output, the equations do not hold and the estimates are biased:\n"
-                       "  fit a window without those samples (--from, --to), or model the saturation\n",
+                       "  fit a window without those samples (--from, --to; --split-at-gaps cuts them out), or model the saturation\n",
                        c.record, c.signal, clipped_sides(c), time_text(c.first_time, c.step, 6), time_text(c.last_time, c.step, 6));
   return out;
 }
 
 std::string clipping_warning(const Clipping& c, const std::string& command) {
-  return fmt::format("{}: warning: {}: `{}` looks clipped: it sits at {} (t = {} to {}); the fit over those samples is biased",
+  return fmt::format("{}: warning: {}: `{}` looks clipped: it sits at {} (t = {} to {}); the fit over those samples is biased "
+                     "(--split-at-gaps cuts them out)",
                      command, c.record, c.signal, clipped_sides(c), time_text(c.first_time, c.step, 6), time_text(c.last_time, c.step, 6));
 }
 

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "ir/queries.hpp"
+#include "runtime/records/clipping.hpp"
 #include "runtime/operators/evaluate.hpp"  // inputs defined by an expression of t, evaluated on the grid
 
 namespace sidc {
@@ -154,6 +155,18 @@ std::variant<Stretches, Diagnostic> unbroken_stretches(const Record& record, con
   std::vector<char> good(n);
   for (std::size_t i = 0; i < n; ++i)
     good[i] = std::all_of(read.begin(), read.end(), [i](const Column* c) { return std::isfinite((*c)[i]); });
+  Stretches out;
+  // A clipped output's samples at its rail are no samples of the system's output either.
+  if (!is_static(model))
+    for (const auto& s : model.signals) {
+      if (s.kind != ir::Signal::Kind::output || s.definition) continue;
+      const auto clipped = clipped_samples(*record.column(column_for(source, s.name)));
+      for (std::size_t i = 0; i < clipped.size(); ++i)
+        if (clipped[i] && good[i]) {
+          good[i] = 0;
+          ++out.rows_clipped;
+        }
+    }
   // The typical spacing: the median over neighbouring good rows.
   std::vector<double> spacing;
   for (std::size_t i = 1; i < n; ++i)
@@ -163,7 +176,6 @@ std::variant<Stretches, Diagnostic> unbroken_stretches(const Record& record, con
   std::nth_element(spacing.begin(), middle, spacing.end());
   const double step = *middle;
   const double allowed = options.uniform.relative_tolerance * std::abs(step);
-  Stretches out;
   IndexRange current{0, 0};
   const auto close = [&](std::size_t end) {
     current.end = end;
@@ -171,7 +183,7 @@ std::variant<Stretches, Diagnostic> unbroken_stretches(const Record& record, con
   };
   for (std::size_t i = 0; i < n; ++i) {
     if (!good[i]) {
-      ++out.rows_left_out;
+      ++out.rows_left_out;  // the clipped ones counted in rows_clipped too
       close(i);
       current.begin = i + 1;
       continue;

@@ -33,13 +33,15 @@ std::variant<SampledRecord, Diagnostic> bind_record(const Record& record, const 
 // each of uniform time step with every column the model reads (time, signals, weights) a finite
 // number. A stretch ends where a row has a faulty cell in such a column (the row is left out) or
 // where the spacing of times leaves the tolerance of the median spacing of the record (a missing
-// sample, a clock jump, a repeated or backward time). Stretches shorter than `min_rows` are
+// sample, a clock jump, a repeated or backward time); a dynamic model's output that looks clipped
+// (clipping.hpp) has its samples at the rail left out like faulty cells. Stretches shorter than `min_rows` are
 // returned in `short_ones`, not in `kept`. A record without a time column, or whose times are all
 // faulty, is an error (nothing tells where a gap is).
 struct Stretches {
   std::vector<IndexRange> kept;
   std::vector<IndexRange> short_ones;
-  std::size_t rows_left_out = 0;  // rows with a faulty cell
+  std::size_t rows_left_out = 0;  // rows with a faulty cell, or where a clipped output sits at its rail
+  std::size_t rows_clipped = 0;   // of those, the clipped ones (clipping.hpp)
 };
 std::variant<Stretches, Diagnostic> unbroken_stretches(const Record& record, const ir::DataSource& source, const ir::Model& model,
                                                        const BindOptions& options, std::size_t min_rows);

@@ -5,14 +5,16 @@
 //
 // Method. A clipped signal repeats its largest (or smallest) value exactly in runs of neighbouring
 // samples, which an unclipped signal does not. Found when
-//   1. at least 3 samples equal to the signal's largest (smallest) value lie in runs of 2 or more;
+//   1. at least 3 samples equal to the signal's largest (smallest) value lie in runs of 2 or more,
+//      one run at least 3 long (a peak sampled symmetrically and rounded repeats its top twice);
 //   2. elsewhere fewer than 1% of neighbouring pairs repeat a value (a coarsely quantised signal,
 //      or one that settles exactly, repeats values everywhere: its extreme runs prove nothing);
-//   3. the signal arrives at a run at speed: some run's entering or leaving difference exceeds the
-//      median absolute difference of neighbouring samples (a smooth turning point or a settling
-//      response reaches its extreme with a difference near 0).
-// Only reported (runtime/records/clipping.cpp is called by the driver for every recorded output):
-// what to do, a window without the runs or a model of the saturation, is the user's choice.
+//   3. the signal arrives at a run at speed: some run's entering or leaving difference exceeds a
+//      tenth of the median absolute difference of neighbouring samples (a response that settles
+//      exactly, or a smooth turning point, reaches its extreme with a difference near 0).
+// Reported (the driver calls clipped_outputs for every recorded output); what to do is the user's
+// choice: a window without the runs, `--split-at-gaps` (which cuts them out like faulty cells:
+// bind_record.hpp, unbroken_stretches), or a model of the saturation.
 //
 // Relies on: nothing. Guarantees: no exceptions; O(n) time, O(1) extra memory beyond a copy of
 // the differences for their median (at most kMaxMedianSamples, evenly spaced).
@@ -45,8 +47,13 @@ struct Clipping {
   bool found() const { return top.found || bottom.found; }
 };
 
-// The clipping of `y` (uniformly sampled); its record and signal names left empty.
+// The clipping of `y` (uniformly sampled; a non-finite sample, a faulty cell, is skipped and breaks
+// a run); its record and signal names left empty.
 Clipping find_clipping(std::span<const double> y);
+
+// Per sample, 1 where `y` sits at a rail find_clipping found (in a run of 2 or more); empty when
+// none was found. `--split-at-gaps` cuts these samples out like faulty cells.
+std::vector<char> clipped_samples(std::span<const double> y);
 
 // Every recorded output of a dynamic `model` in `record` examined; one entry per clipped output.
 std::vector<Clipping> clipped_outputs(const SampledRecord& record, const ir::Model& model);

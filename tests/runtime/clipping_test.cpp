@@ -56,12 +56,27 @@ TEST(Clipping, UnclippedSignalsAreNot) {
   auto coarse = sine(3000, 0.0, 1);
   for (double& v : coarse) v = std::round(v / 0.05) * 0.05;
   EXPECT_FALSE(find_clipping(coarse).found());
-  // Too short, constant, not finite: nothing to say.
+  // Too short, constant: nothing to say.
   EXPECT_FALSE(find_clipping(clipped(sine(19, 0.0, 1), -1, 0.1)).found());
   EXPECT_FALSE(find_clipping(std::vector<double>(100, 1.0)).found());
-  auto with_nan = clipped(sine(1000, 0.0, 1), -1, 0.9);
-  with_nan[10] = std::nan("");
-  EXPECT_FALSE(find_clipping(with_nan).found());
+}
+
+TEST(Clipping, AFaultyCellIsNoSampleAndTheClippedSamplesAreMarked) {
+  auto y = clipped(sine(1000, 1e-3, 1), -10.0, 0.9);
+  y[10] = std::nan("");
+  const Clipping c = find_clipping(y);
+  ASSERT_TRUE(c.top.found);
+  const auto marked = clipped_samples(y);
+  ASSERT_EQ(marked.size(), y.size());
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    count += marked[i] != 0;
+    if (marked[i]) {
+      EXPECT_EQ(y[i], 0.9);
+    }
+  }
+  EXPECT_EQ(count, c.top.samples);
+  EXPECT_TRUE(clipped_samples(sine(1000, 1e-3, 1)).empty());
 }
 
 }  // namespace sidc::clipping_test

@@ -4,11 +4,14 @@
 // apart; a record without a time column is the binding's error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "runtime/records/bind_record.hpp"
+#include "support/simulation.hpp"
 
 namespace sidc::gaps_test {
 
@@ -87,6 +90,28 @@ TEST(UnbrokenStretches, ShortStretchesAreSetApart) {
   const Stretches s = stretches_of(record_text(40, {{5, "0.5,,0.5"}, {8, "0.8,,0.8"}}), 10);
   EXPECT_EQ(ranges(s.kept), (Ranges{{9, 40}}));
   EXPECT_EQ(ranges(s.short_ones), (Ranges{{0, 5}, {6, 8}}));
+}
+
+TEST(UnbrokenStretches, AClippedOutputsRailSamplesAreLeftOut) {
+  // y = sin(t) read by a sensor that saturates at 0.8: every run at 0.8 cut out.
+  std::string text = "t,x,y\n";
+  std::size_t at_rail = 0;
+  for (std::size_t k = 0; k < 400; ++k) {
+    const double t = 0.05 * static_cast<double>(k), y = std::min(0.8, std::sin(t) + 0.001 * std::sin(37.0 * t));
+    at_rail += y == 0.8;
+    text += std::to_string(t) + ",1," + (y == 0.8 ? std::string("0.8") : std::to_string(y)) + "\n";
+  }
+  auto record = parse_csv(text, "clipped.csv");
+  ASSERT_TRUE(std::holds_alternative<Record>(record));
+  const ir::Model dynamic = testing::normalized("model clipped\ninput x\noutput y\nparam a, b\na*y' + b*y = x\n");
+  auto found = unbroken_stretches(std::get<Record>(record), ir::DataSource{}, dynamic, BindOptions{}, 5);
+  ASSERT_TRUE(std::holds_alternative<Stretches>(found));
+  const Stretches& s = std::get<Stretches>(found);
+  EXPECT_EQ(s.rows_clipped, at_rail);
+  EXPECT_EQ(s.rows_left_out, at_rail);
+  EXPECT_GE(s.kept.size(), 3u);
+  // A static model's rows are no time series: nothing is taken for clipped.
+  EXPECT_EQ(stretches_of(text, 5).rows_clipped, 0u);
 }
 
 TEST(UnbrokenStretches, WithoutATimeColumnOrAnyGoodPairItIsAnError) {

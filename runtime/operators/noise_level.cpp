@@ -5,27 +5,10 @@
 #include <cmath>
 #include <vector>
 
+#include "runtime/robust_scale.hpp"
+
 namespace sidc {
 namespace {
-
-// 1 / Phi^-1(3/4): the MAD of a normal law times this is its standard deviation.
-constexpr double kMadToSigma = 1.482602218505602;
-
-double median_in_place(std::vector<double>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  double m = *mid;
-  if (v.size() % 2 == 0) m = 0.5 * (m + *std::max_element(v.begin(), mid));
-  return m;
-}
-
-// 1.4826 * median |x - median(x)|.
-double robust_scale(std::vector<double> x) {
-  if (x.empty()) return 0;
-  const double centre = median_in_place(x);
-  for (double& v : x) v = std::abs(v - centre);
-  return kMadToSigma * median_in_place(x);
-}
 
 double binomial(int n, int k) {
   double c = 1;

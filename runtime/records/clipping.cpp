@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "ir/queries.hpp"
+#include "runtime/robust_scale.hpp"
 
 namespace sidc {
 namespace {
@@ -58,10 +59,7 @@ double median_difference(std::span<const double> y) {
   d.reserve(count / stride + 1);
   for (std::size_t i = 1; i < y.size(); i += stride)
     if (const double step = std::abs(y[i] - y[i - 1]); std::isfinite(step)) d.push_back(step);
-  if (d.empty()) return 0;
-  const auto middle = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
-  std::nth_element(d.begin(), middle, d.end());
-  return *middle;
+  return d.empty() ? 0.0 : median_in_place(d);
 }
 
 }  // namespace

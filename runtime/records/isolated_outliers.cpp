@@ -7,6 +7,7 @@
 #include <boost/math/distributions/normal.hpp>
 
 #include "ir/queries.hpp"
+#include "runtime/robust_scale.hpp"
 
 namespace sidc {
 namespace {
@@ -17,7 +18,6 @@ constexpr std::size_t kLocal = 64;               // samples either side of the s
 constexpr std::size_t kMaxScaleSamples = 200000;  // residuals the global scale is read from
 constexpr std::size_t kStretch = 1000;            // ... in evenly spaced stretches of this many
 constexpr double kFamilyFalseAlarm = 0.01;        // chance of one false alarm on a whole Gaussian signal
-constexpr double kMadToSigma = 1.4826;
 // Test 3's bound on each side's miss, in units of the one-sided residuals' robust scale: noise
 // alone exceeds it with about 0.3% chance.
 constexpr double kSideBound = 3.0;
@@ -38,16 +38,6 @@ double from_left(std::span<const double> y, std::size_t i) { return y[i] - (y[i 
 double from_right(std::span<const double> y, std::size_t i) { return y[i] - (y[i + 1] + 0.5 * y[i + 2] - 0.5 * y[i + 4]); }
 using Residual = double (*)(std::span<const double>, std::size_t);
 
-double mad_scale(std::vector<double>& r) {
-  if (r.empty()) return 0;
-  const auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
-  std::nth_element(r.begin(), mid, r.end());
-  const double median = *mid;
-  for (double& x : r) x = std::abs(x - median);
-  std::nth_element(r.begin(), mid, r.end());
-  return kMadToSigma * *mid;
-}
-
 // The residuals' robust scale over the whole signal (evenly spaced stretches beyond kMaxScaleSamples).
 double global_scale(std::span<const double> y, Residual f) {
   const std::size_t first = kSide, last = y.size() - kSide;  // residuals at [first, last)
@@ -64,7 +54,7 @@ double global_scale(std::span<const double> y, Residual f) {
       for (std::size_t i = start; i < start + kStretch; ++i) r.push_back(f(y, i));
     }
   }
-  return mad_scale(r);
+  return robust_scale(std::move(r));
 }
 
 // The quantisation step q of the signal: the smallest non-zero difference of neighbours (0 when
@@ -84,7 +74,7 @@ double local_scale(std::span<const double> y, std::size_t i, Residual f) {
   const std::size_t hi = std::min(y.size() - kSide, i + kHalf + 1 + kLocal);
   for (std::size_t k = lo; k + kHalf < i; ++k) r.push_back(f(y, k));
   for (std::size_t k = i + kHalf + 1; k < hi; ++k) r.push_back(f(y, k));
-  return r.size() >= 8 ? mad_scale(r) : 0.0;
+  return r.size() >= 8 ? robust_scale(std::move(r)) : 0.0;
 }
 
 // Test 2: the six neighbours' residuals, the spike's imprint taken out, all within the bound.

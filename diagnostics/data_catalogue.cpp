@@ -246,6 +246,14 @@ Diagnostic no_stretch_to_fit(std::string_view path) {
   return d;
 }
 
+Diagnostic no_long_stretch(std::string_view path, std::size_t min_rows, std::size_t shorter) {
+  Diagnostic d;
+  d.code = "data-no-stretch";
+  d.message = fmt::format("`{}` has no unbroken stretch of {} rows or more between its gaps ({} shorter)", shown_path(path), min_rows, shorter);
+  d.hint = "fill the gaps, or --resample to interpolate across them";
+  return d;
+}
+
 Diagnostic no_time_column(std::string_view path, int header_row) {
   return located("data-no-time-column", path, header_row, 1,
                  "the record has no time column (`t` or `time`) and no sampling step was given",

@@ -76,8 +76,10 @@ Diagnostic empty_time_window(std::string_view path, std::string_view name, doubl
 Diagnostic invalid_signal_options(std::string_view operation, std::string_view why);
 // Binding a record to a model (runtime/records/bind_record.cpp, runtime/operators/evaluate.cpp).
 Diagnostic no_time_column(std::string_view path, int header_row);
-// --split-at-gaps on a record without two neighbouring good rows.
+// --split-at-gaps on a record without two neighbouring good rows, or without a stretch of
+// `min_rows` between its gaps (`shorter`: how many it has that are shorter).
 Diagnostic no_stretch_to_fit(std::string_view path);
+Diagnostic no_long_stretch(std::string_view path, std::size_t min_rows, std::size_t shorter);
 Diagnostic empty_fit_window(std::string_view path, std::size_t samples, int order, std::size_t margin, bool cut_by_window);
 Diagnostic signal_shorter_than_window(std::size_t samples, int window);
 

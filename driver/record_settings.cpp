@@ -106,10 +106,7 @@ std::variant<std::vector<SampledRecord>, Diagnostic> split_and_bind(RecordInput 
   if (auto* d = std::get_if<Diagnostic>(&found)) return *d;
   const Stretches& stretches = std::get<Stretches>(found);
   if (stretches.kept.empty())
-    return diag::error("data-no-stretch", Span{},
-                       fmt::format("`{}` has no unbroken stretch of {} rows or more between its gaps ({} shorter)", record.path, kMinStretchRows,
-                                   stretches.short_ones.size()),
-                       "fill the gaps, or --resample to interpolate across them");
+    return data_diag::no_long_stretch(record.path, kMinStretchRows, stretches.short_ones.size());
   std::vector<SampledRecord> out;
   if (stretches.kept.size() == 1 && stretches.kept.front().size() == record.rows()) {
     notes += fmt::format("record {}: no gap to split at: fitted whole\n", record.path);
